@@ -1,0 +1,242 @@
+// Named, typed per-element arrays ("properties"), pmp-style. A PropertyContainer holds
+// the arrays of one element kind and keeps them all the same length; garbage collection
+// and builders move whole arrays at once through the type-erased PropertyArray.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <memory>
+#include <span>
+#include <string>
+#include <type_traits>
+#include <typeinfo>
+#include <utility>
+#include <vector>
+
+#include "hedge/error.h"
+#include "hedge/handles.h"
+#include "hedge/vec.h"
+
+namespace hedge {
+
+//! Element scalar types of host attribute channels.
+enum class ScalarType : std::uint8_t { f32, f64, i8, u8, i16, u16, i32, u32, i64, u64 };
+std::size_t scalar_size(ScalarType type);
+const char* scalar_name(ScalarType type);
+
+//! Type-erased array of one property: what containers need to keep arrays in step.
+class PropertyArray {
+ public:
+  explicit PropertyArray(std::string name) : name_(std::move(name)) {}
+  virtual ~PropertyArray() = default;
+  const std::string& name() const { return name_; }
+
+  virtual std::size_t size() const = 0;
+  virtual void resize(std::size_t n) = 0;
+  virtual void reserve(std::size_t n) = 0;
+  virtual void push_back() = 0;
+  virtual void shrink_to_fit() = 0;
+  virtual void swap_elements(std::size_t a, std::size_t b) = 0;
+  virtual void copy_element(std::size_t from, std::size_t to) = 0;
+  //! element[to] = sum w_i element[from_i] for numbers; the value of the largest weight otherwise.
+  virtual void interpolate(std::size_t to, std::span<const Index> from, std::span<const float> weights) = 0;
+  //! Gather: new[i] = old[new_to_old[i]]; the size becomes new_to_old.size().
+  virtual void permute(std::span<const Index> new_to_old) = 0;
+  virtual std::unique_ptr<PropertyArray> clone() const = 0;
+  virtual const std::type_info& type() const = 0;
+  //! Heap bytes held (capacity, not size).
+  virtual std::size_t heap_bytes() const = 0;
+
+ private:
+  std::string name_;
+};
+
+namespace detail {
+template <class T>
+struct is_vec : std::false_type {};
+template <class T, int N>
+struct is_vec<Vec<T, N>> : std::true_type {};
+template <class T>
+inline constexpr bool is_interpolable_v =
+    std::is_floating_point_v<T> || (is_vec<T>::value && std::is_floating_point_v<std::remove_cvref_t<decltype(T{}[0])>>);
+
+inline std::size_t largest_weight(std::span<const float> weights) {
+  std::size_t best = 0;
+  for (std::size_t i = 1; i < weights.size(); ++i)
+    if (weights[i] > weights[best]) best = i;
+  return best;
+}
+}  // namespace detail
+
+//! A property of values of type T, with a default for new elements.
+template <class T>
+class TypedArray final : public PropertyArray {
+ public:
+  TypedArray(std::string name, T default_value) : PropertyArray(std::move(name)), default_(std::move(default_value)) {}
+
+  std::vector<T>& vector() { return data_; }
+  const std::vector<T>& vector() const { return data_; }
+  const T& default_value() const { return default_; }
+
+  std::size_t size() const override { return data_.size(); }
+  void resize(std::size_t n) override { data_.resize(n, default_); }
+  void reserve(std::size_t n) override { data_.reserve(n); }
+  void push_back() override { data_.push_back(default_); }
+  void shrink_to_fit() override { data_.shrink_to_fit(); }
+  void swap_elements(std::size_t a, std::size_t b) override {
+    T tmp = data_[a];
+    data_[a] = data_[b];
+    data_[b] = tmp;
+  }
+  void copy_element(std::size_t from, std::size_t to) override { data_[to] = T(data_[from]); }
+  void interpolate(std::size_t to, std::span<const Index> from, std::span<const float> weights) override {
+    if (from.empty()) return;
+    if constexpr (detail::is_interpolable_v<T>) {
+      T sum{};
+      for (std::size_t i = 0; i < from.size(); ++i) sum += data_[from[i]] * weights[i];
+      data_[to] = sum;
+    } else {
+      data_[to] = T(data_[from[detail::largest_weight(weights)]]);
+    }
+  }
+  void permute(std::span<const Index> new_to_old) override {
+    std::vector<T> out;
+    out.reserve(new_to_old.size());
+    for (Index i : new_to_old) out.push_back(data_[i]);
+    data_.swap(out);
+  }
+  std::unique_ptr<PropertyArray> clone() const override { return std::make_unique<TypedArray>(*this); }
+  const std::type_info& type() const override { return typeid(T); }
+  std::size_t heap_bytes() const override {
+    if constexpr (std::is_same_v<T, bool>)
+      return data_.capacity() / 8;
+    else
+      return data_.capacity() * sizeof(T);
+  }
+
+ private:
+  std::vector<T> data_;
+  T default_;
+};
+
+//! A host attribute channel: `components` scalars of one ScalarType per element, kept as
+//! raw bytes so that a round trip is bit for bit.
+class ChannelArray final : public PropertyArray {
+ public:
+  ChannelArray(std::string name, ScalarType scalar, int components)
+      : PropertyArray(std::move(name)), scalar_(scalar), components_(components),
+        stride_(scalar_size(scalar) * static_cast<std::size_t>(components)) {}
+
+  ScalarType scalar() const { return scalar_; }
+  int components() const { return components_; }
+  std::size_t stride() const { return stride_; }
+  std::vector<std::byte>& bytes() { return data_; }
+  const std::vector<std::byte>& bytes() const { return data_; }
+  std::byte* element(std::size_t i) { return data_.data() + i * stride_; }
+  const std::byte* element(std::size_t i) const { return data_.data() + i * stride_; }
+
+  std::size_t size() const override { return stride_ ? data_.size() / stride_ : 0; }
+  void resize(std::size_t n) override { data_.resize(n * stride_); }
+  void reserve(std::size_t n) override { data_.reserve(n * stride_); }
+  void push_back() override { data_.resize(data_.size() + stride_); }
+  void shrink_to_fit() override { data_.shrink_to_fit(); }
+  void swap_elements(std::size_t a, std::size_t b) override;
+  void copy_element(std::size_t from, std::size_t to) override {
+    if (from != to) std::memcpy(element(to), element(from), stride_);
+  }
+  void interpolate(std::size_t to, std::span<const Index> from, std::span<const float> weights) override;
+  void permute(std::span<const Index> new_to_old) override;
+  std::unique_ptr<PropertyArray> clone() const override { return std::make_unique<ChannelArray>(*this); }
+  const std::type_info& type() const override { return typeid(ChannelArray); }
+  std::size_t heap_bytes() const override { return data_.capacity(); }
+
+ private:
+  ScalarType scalar_;
+  int components_;
+  std::size_t stride_;
+  std::vector<std::byte> data_;
+};
+
+//! A typed view of one property of element kind H (Vertex, Halfedge, Edge or Face).
+//! Valid while the property exists; cheap to copy.
+template <class H, class T>
+class Property {
+ public:
+  Property() = default;
+  explicit Property(TypedArray<T>* array) : array_(array) {}
+  explicit operator bool() const { return array_ != nullptr; }
+
+  decltype(auto) operator[](H h) { return array_->vector()[h.idx()]; }
+  decltype(auto) operator[](H h) const { return std::as_const(array_->vector())[h.idx()]; }
+  std::vector<T>& vector() { return array_->vector(); }
+  const std::vector<T>& vector() const { return array_->vector(); }
+  const std::string& name() const { return array_->name(); }
+
+ private:
+  TypedArray<T>* array_ = nullptr;
+};
+
+template <class T>
+using VertexProperty = Property<Vertex, T>;
+template <class T>
+using HalfedgeProperty = Property<Halfedge, T>;
+template <class T>
+using EdgeProperty = Property<Edge, T>;
+template <class T>
+using FaceProperty = Property<Face, T>;
+
+//! The properties of one element kind, all of length size().
+class PropertyContainer {
+ public:
+  PropertyContainer() = default;
+  PropertyContainer(const PropertyContainer& other);
+  PropertyContainer& operator=(const PropertyContainer& other);
+  PropertyContainer(PropertyContainer&&) noexcept = default;
+  PropertyContainer& operator=(PropertyContainer&&) noexcept = default;
+
+  std::size_t size() const { return size_; }
+  std::size_t count() const { return arrays_.size(); }
+  std::vector<std::string> names() const;
+  PropertyArray* find(const std::string& name) const;
+  PropertyArray& at(std::size_t i) const { return *arrays_[i]; }
+  bool exists(const std::string& name) const { return find(name) != nullptr; }
+
+  template <class T>
+  TypedArray<T>* add(const std::string& name, T default_value = T()) {
+    if (exists(name)) throw Error("property '" + name + "' exists already");
+    auto array = std::make_unique<TypedArray<T>>(name, std::move(default_value));
+    array->resize(size_);
+    auto* raw = array.get();
+    arrays_.push_back(std::move(array));
+    return raw;
+  }
+  template <class T>
+  TypedArray<T>* get(const std::string& name) const {
+    PropertyArray* array = find(name);
+    return array && array->type() == typeid(T) ? static_cast<TypedArray<T>*>(array) : nullptr;
+  }
+  ChannelArray* add_channel(const std::string& name, ScalarType scalar, int components);
+  ChannelArray* get_channel(const std::string& name) const;
+  void remove(const std::string& name);
+  void clear() {
+    arrays_.clear();
+    size_ = 0;
+  }
+
+  void resize(std::size_t n);
+  void reserve(std::size_t n);
+  void push_back();
+  void shrink_to_fit();
+  void swap_elements(std::size_t a, std::size_t b);
+  void copy_element(std::size_t from, std::size_t to);
+  void interpolate(std::size_t to, std::span<const Index> from, std::span<const float> weights);
+  void permute(std::span<const Index> new_to_old);
+  std::size_t heap_bytes() const;
+
+ private:
+  std::vector<std::unique_ptr<PropertyArray>> arrays_;
+  std::size_t size_ = 0;
+};
+
+}  // namespace hedge
