@@ -1,0 +1,293 @@
+// The half-edge mesh: allocation, queries that walk a neighbourhood, deletion and garbage
+// collection. Euler operations live in euler.cpp.
+#include "hedge/mesh.h"
+
+#include <algorithm>
+
+#include "hedge/error.h"
+
+namespace hedge {
+
+void Mesh::clear() { *this = Mesh(); }
+
+void Mesh::reserve(std::size_t vertices, std::size_t edges, std::size_t faces) {
+  vertex_halfedge_.reserve(vertices);
+  positions_.reserve(vertices);
+  vprops_.reserve(vertices);
+  halfedges_.reserve(2 * edges);
+  hprops_.reserve(2 * edges);
+  eprops_.reserve(edges);
+  face_halfedge_.reserve(faces);
+  fprops_.reserve(faces);
+}
+
+void Mesh::shrink_to_fit() {
+  vertex_halfedge_.shrink_to_fit();
+  positions_.shrink_to_fit();
+  halfedges_.shrink_to_fit();
+  face_halfedge_.shrink_to_fit();
+  vdeleted_.shrink_to_fit();
+  edeleted_.shrink_to_fit();
+  fdeleted_.shrink_to_fit();
+  vprops_.shrink_to_fit();
+  hprops_.shrink_to_fit();
+  eprops_.shrink_to_fit();
+  fprops_.shrink_to_fit();
+}
+
+namespace {
+// Handles are 32-bit; refuse growth that would wrap an index instead of corrupting.
+void check_capacity(std::size_t count, const char* what) {
+  if (count >= static_cast<std::size_t>(kInvalidIndex))
+    throw Error(std::string("mesh too large: more than 4,294,967,294 ") + what + " do not fit 32-bit indices");
+}
+}  // namespace
+
+Vertex Mesh::new_vertex() {
+  check_capacity(vertices_size() + 1, "vertices");
+  vertex_halfedge_.emplace_back();
+  positions_.emplace_back();
+  vprops_.push_back();
+  if (deleted_vertices_) vdeleted_.push_back(false);
+  return Vertex(static_cast<Index>(vertices_size() - 1));
+}
+
+Halfedge Mesh::new_edge(Vertex from, Vertex to) {
+  check_capacity(halfedges_size() + 2, "half-edges");
+  halfedges_.push_back({to, Face(), Halfedge(), Halfedge()});
+  halfedges_.push_back({from, Face(), Halfedge(), Halfedge()});
+  hprops_.push_back();
+  hprops_.push_back();
+  eprops_.push_back();
+  if (deleted_edges_) edeleted_.push_back(false);
+  return Halfedge(static_cast<Index>(halfedges_size() - 2));
+}
+
+Face Mesh::new_face() {
+  check_capacity(faces_size() + 1, "faces");
+  face_halfedge_.emplace_back();
+  fprops_.push_back();
+  if (deleted_faces_) fdeleted_.push_back(false);
+  return Face(static_cast<Index>(faces_size() - 1));
+}
+
+void Mesh::resize(std::size_t vertices, std::size_t edges, std::size_t faces) {
+  check_capacity(vertices, "vertices");
+  check_capacity(2 * edges, "half-edges");
+  check_capacity(faces, "faces");
+  vertex_halfedge_.resize(vertices);
+  positions_.resize(vertices);
+  vprops_.resize(vertices);
+  halfedges_.resize(2 * edges);
+  hprops_.resize(2 * edges);
+  eprops_.resize(edges);
+  face_halfedge_.resize(faces);
+  fprops_.resize(faces);
+  if (deleted_vertices_) vdeleted_.resize(vertices, false);
+  if (deleted_edges_) edeleted_.resize(edges, false);
+  if (deleted_faces_) fdeleted_.resize(faces, false);
+}
+
+void Mesh::adjust_outgoing_halfedge(Vertex v) {
+  Halfedge start = halfedge(v);
+  if (!start.is_valid()) return;
+  Halfedge h = start;
+  do {
+    if (is_boundary(h)) {
+      set_halfedge(v, h);
+      return;
+    }
+    h = ccw_rotated(h);
+  } while (h != start);
+}
+
+bool Mesh::is_boundary(Face f) const {
+  for (Halfedge h : halfedges(f))
+    if (is_boundary(opposite(h))) return true;
+  return false;
+}
+
+std::size_t Mesh::valence(Vertex v) const {
+  std::size_t n = 0;
+  for ([[maybe_unused]] Halfedge h : outgoing(v)) ++n;
+  return n;
+}
+
+std::size_t Mesh::valence(Face f) const {
+  std::size_t n = 0;
+  for ([[maybe_unused]] Halfedge h : halfedges(f)) ++n;
+  return n;
+}
+
+bool Mesh::is_triangle_mesh() const {
+  for (Face f : faces())
+    if (valence(f) != 3) return false;
+  return true;
+}
+
+bool Mesh::is_quad_mesh() const {
+  for (Face f : faces())
+    if (valence(f) != 4) return false;
+  return true;
+}
+
+Halfedge Mesh::find_halfedge(Vertex a, Vertex b) const {
+  for (Halfedge h : outgoing(a))
+    if (to_vertex(h) == b) return h;
+  return Halfedge();
+}
+
+Edge Mesh::find_edge(Vertex a, Vertex b) const {
+  Halfedge h = find_halfedge(a, b);
+  return h.is_valid() ? edge(h) : Edge();
+}
+
+void Mesh::mark_deleted(Vertex v) {
+  if (is_deleted(v)) return;
+  if (vdeleted_.size() != vertices_size()) vdeleted_.assign(vertices_size(), false);
+  vdeleted_[v.idx()] = true;
+  ++deleted_vertices_;
+}
+
+void Mesh::mark_deleted(Edge e) {
+  if (is_deleted(e)) return;
+  if (edeleted_.size() != edges_size()) edeleted_.assign(edges_size(), false);
+  edeleted_[e.idx()] = true;
+  ++deleted_edges_;
+}
+
+void Mesh::mark_deleted(Face f) {
+  if (is_deleted(f)) return;
+  if (fdeleted_.size() != faces_size()) fdeleted_.assign(faces_size(), false);
+  fdeleted_[f.idx()] = true;
+  ++deleted_faces_;
+}
+
+void Mesh::delete_face(Face f) {
+  if (is_deleted(f)) return;
+  mark_deleted(f);
+
+  // The face's half-edges become boundary; edges with no face left on either side go,
+  // and so do vertices that end up with no edge.
+  std::vector<Halfedge> loop;
+  std::vector<Edge> dead_edges;
+  std::vector<Vertex> touched;
+  for (Halfedge h : halfedges(f)) {
+    loop.push_back(h);
+    touched.push_back(to_vertex(h));
+  }
+  for (Halfedge h : loop) {
+    set_face(h, Face());
+    if (is_boundary(opposite(h))) dead_edges.push_back(edge(h));
+  }
+
+  for (Edge e : dead_edges) {
+    Halfedge h0 = halfedge(e, 0), h1 = halfedge(e, 1);
+    Vertex v0 = to_vertex(h0), v1 = to_vertex(h1);
+    Halfedge next0 = next(h0), prev0 = prev(h0);
+    Halfedge next1 = next(h1), prev1 = prev(h1);
+    // Unlink the edge from both loops; keep the vertices' outgoing half-edges valid.
+    set_next(prev0, next1);
+    set_next(prev1, next0);
+    if (halfedge(v0) == h1) set_halfedge(v0, next0 == h1 ? Halfedge() : next0);
+    if (halfedge(v1) == h0) set_halfedge(v1, next1 == h0 ? Halfedge() : next1);
+    mark_deleted(e);
+  }
+
+  for (Vertex v : touched) {
+    if (!halfedge(v).is_valid())
+      mark_deleted(v);
+    else
+      adjust_outgoing_halfedge(v);
+  }
+}
+
+void Mesh::delete_edge(Edge e) {
+  Face f0 = face(e, 0), f1 = face(e, 1);
+  if (f0.is_valid()) delete_face(f0);
+  if (f1.is_valid()) delete_face(f1);
+}
+
+void Mesh::delete_vertex(Vertex v) {
+  if (is_deleted(v)) return;
+  std::vector<Face> around;
+  for (Face f : faces(v)) around.push_back(f);
+  for (Face f : around) delete_face(f);
+  if (!is_deleted(v) && is_isolated(v)) mark_deleted(v);
+}
+
+namespace {
+// Old -> new index for live elements, new -> old for the gather; keeps relative order.
+template <class IsDeleted>
+void compaction_maps(std::size_t n, IsDeleted is_deleted, std::vector<Index>& old_to_new, std::vector<Index>& new_to_old) {
+  old_to_new.assign(n, kInvalidIndex);
+  new_to_old.clear();
+  for (std::size_t i = 0; i < n; ++i)
+    if (!is_deleted(static_cast<Index>(i))) {
+      old_to_new[i] = static_cast<Index>(new_to_old.size());
+      new_to_old.push_back(static_cast<Index>(i));
+    }
+}
+
+template <class T>
+void gather(std::vector<T>& data, const std::vector<Index>& new_to_old) {
+  std::vector<T> out;
+  out.reserve(new_to_old.size());
+  for (Index i : new_to_old) out.push_back(data[i]);
+  data.swap(out);
+}
+}  // namespace
+
+GarbageMaps Mesh::garbage_collect() {
+  GarbageMaps maps;
+  std::vector<Index> vkeep, ekeep, hkeep, fkeep;
+  compaction_maps(vertices_size(), [&](Index i) { return is_deleted(Vertex(i)); }, maps.vertices, vkeep);
+  compaction_maps(edges_size(), [&](Index i) { return is_deleted(Edge(i)); }, maps.edges, ekeep);
+  compaction_maps(faces_size(), [&](Index i) { return is_deleted(Face(i)); }, maps.faces, fkeep);
+  maps.halfedges.assign(halfedges_size(), kInvalidIndex);
+  hkeep.reserve(2 * ekeep.size());
+  for (Index e : ekeep) {
+    maps.halfedges[2 * e] = static_cast<Index>(hkeep.size());
+    hkeep.push_back(2 * e);
+    maps.halfedges[2 * e + 1] = static_cast<Index>(hkeep.size());
+    hkeep.push_back(2 * e + 1);
+  }
+  if (!has_garbage()) return maps;
+
+  auto map_h = [&](Halfedge h) { return h.is_valid() ? Halfedge(maps.halfedges[h.idx()]) : h; };
+  auto map_v = [&](Vertex v) { return v.is_valid() ? Vertex(maps.vertices[v.idx()]) : v; };
+  auto map_f = [&](Face f) { return f.is_valid() ? Face(maps.faces[f.idx()]) : f; };
+
+  gather(vertex_halfedge_, vkeep);
+  gather(positions_, vkeep);
+  for (Halfedge& h : vertex_halfedge_) h = map_h(h);
+  gather(halfedges_, hkeep);
+  for (HalfedgeRecord& r : halfedges_) {
+    r.vertex = map_v(r.vertex);
+    r.face = map_f(r.face);
+    r.next = map_h(r.next);
+    r.prev = map_h(r.prev);
+  }
+  gather(face_halfedge_, fkeep);
+  for (Halfedge& h : face_halfedge_) h = map_h(h);
+
+  vprops_.permute(vkeep);
+  hprops_.permute(hkeep);
+  eprops_.permute(ekeep);
+  fprops_.permute(fkeep);
+
+  vdeleted_.clear();
+  edeleted_.clear();
+  fdeleted_.clear();
+  deleted_vertices_ = deleted_edges_ = deleted_faces_ = 0;
+  return maps;
+}
+
+std::size_t Mesh::heap_bytes() const {
+  return halfedges_.capacity() * sizeof(HalfedgeRecord) + vertex_halfedge_.capacity() * sizeof(Halfedge) +
+         face_halfedge_.capacity() * sizeof(Halfedge) + positions_.capacity() * sizeof(Point) +
+         (vdeleted_.capacity() + edeleted_.capacity() + fdeleted_.capacity()) / 8 + vprops_.heap_bytes() +
+         hprops_.heap_bytes() + eprops_.heap_bytes() + fprops_.heap_bytes();
+}
+
+}  // namespace hedge
