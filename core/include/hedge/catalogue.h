@@ -1,0 +1,108 @@
+// The catalogue: every operation declared once (id, title, category, help, parameters and
+// the function that runs it). The CLI, the MeshLab plugin and the Blender add-on generate
+// their commands, filters and operators from this list and nothing else.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "hedge/build.h"
+#include "hedge/mesh.h"
+#include "hedge/progress.h"
+#include "hedge/soup.h"
+
+namespace hedge {
+
+enum class ParamType { boolean, integer, real, choice };
+const char* param_type_name(ParamType type);
+
+//! One parameter. Ids are snake_case and identical in every front end (CLI flags use
+//! dashes: --target-ratio).
+struct ParamSpec {
+  std::string id;
+  std::string label;  //!< short name for UIs, e.g. "Target ratio"
+  std::string help;
+  ParamType type = ParamType::real;
+  double default_value = 0;  //!< bool: 0/1; choice: index into choices
+  double min = 0, max = 0;   //!< inclusive range for integer and real
+  std::vector<std::string> choices;  //!< for choice
+
+  static ParamSpec boolean(std::string id, std::string label, bool def, std::string help);
+  static ParamSpec integer(std::string id, std::string label, std::int64_t def, std::int64_t min, std::int64_t max, std::string help);
+  static ParamSpec real(std::string id, std::string label, double def, double min, double max, std::string help);
+  static ParamSpec choice(std::string id, std::string label, std::vector<std::string> choices, std::size_t def, std::string help);
+  //! The default as text, as a user would type it.
+  std::string default_text() const;
+  //! "0 to 1", "one of loop, catmull_clark", "true or false".
+  std::string range_text() const;
+};
+
+using Value = std::variant<bool, std::int64_t, double, std::string>;
+std::string value_text(const Value& value);
+
+//! Checked parameter values of one run: every parameter of the operation is present.
+class ParamValues {
+ public:
+  bool get_bool(const std::string& id) const;
+  std::int64_t get_int(const std::string& id) const;
+  double get_real(const std::string& id) const;
+  const std::string& get_choice(const std::string& id) const;
+  void set(const std::string& id, Value value) { values_[id] = std::move(value); }
+  const std::map<std::string, Value>& all() const { return values_; }
+
+ private:
+  const Value& at(const std::string& id) const;
+  std::map<std::string, Value> values_;
+};
+
+//! What an operation did, in order: counts, measured errors, time. Hosts show it; the CLI
+//! prints it (or as JSON).
+struct OperationReport {
+  std::vector<std::pair<std::string, Value>> entries;
+  std::vector<std::string> messages;
+
+  void add(std::string key, Value value) { entries.emplace_back(std::move(key), std::move(value)); }
+  const Value* find(const std::string& key) const;
+  std::string to_text() const;
+  std::string to_json() const;
+};
+
+struct Operation {
+  std::string id;        //!< snake_case: "decimate"
+  std::string title;     //!< "Decimate": MeshLab shows "Hedge: Decimate"
+  std::string category;  //!< "Remeshing", "Smoothing", "Cleaning", "Measure"
+  std::string help;      //!< what it does, when to use it, the paper it follows
+  std::vector<ParamSpec> params;
+  bool changes_mesh = true;  //!< false for report-only operations
+  std::function<OperationReport(Mesh&, const ParamValues&, Progress&)> run;
+
+  const ParamSpec* find_param(const std::string& id) const;
+};
+
+//! Every operation, in menu order.
+const std::vector<Operation>& catalogue();
+//! Throws Error listing the known ids when there is no such operation.
+const Operation& find_operation(const std::string& id);
+
+//! Turns text values (CLI, scripts) into checked values; parameters not given take their
+//! defaults. Unknown ids, wrong types and out-of-range values throw Error naming the
+//! parameter and what is allowed.
+ParamValues resolve_params(const Operation& op, const std::map<std::string, std::string>& given);
+//! Same for typed values (MeshLab, Blender).
+ParamValues resolve_params(const Operation& op, const std::map<std::string, Value>& given);
+
+struct RunResult {
+  Soup soup;              //!< the result; empty for report-only operations (changes_mesh false)
+  OperationReport report; //!< the operation's report, after the build report's entries
+  BuildReport build;
+};
+
+//! The whole pipeline the hosts call: build, run, validate, extract. Throws Error (or
+//! Cancelled) and leaves `input` untouched on failure.
+RunResult run_operation(const Operation& op, const Soup& input, const ParamValues& params, Progress& progress);
+
+}  // namespace hedge

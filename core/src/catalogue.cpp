@@ -1,0 +1,285 @@
+// The catalogue of operations, parameter checking, and the build -> run -> extract
+// pipeline shared by every front end.
+#include "hedge/catalogue.h"
+
+#include <charconv>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "hedge/error.h"
+#include "hedge/validate.h"
+#include "operations/list.h"
+
+namespace hedge {
+
+#define HEDGE_DECLARE_OPERATION(name) Operation name##_operation();
+HEDGE_OPERATIONS(HEDGE_DECLARE_OPERATION)
+#undef HEDGE_DECLARE_OPERATION
+
+const char* param_type_name(ParamType type) {
+  switch (type) {
+    case ParamType::boolean: return "bool";
+    case ParamType::integer: return "int";
+    case ParamType::real: return "float";
+    case ParamType::choice: return "enum";
+  }
+  return "unknown";
+}
+
+ParamSpec ParamSpec::boolean(std::string id, std::string label, bool def, std::string help) {
+  return {std::move(id), std::move(label), std::move(help), ParamType::boolean, def ? 1.0 : 0.0, 0, 1, {}};
+}
+ParamSpec ParamSpec::integer(std::string id, std::string label, std::int64_t def, std::int64_t min, std::int64_t max,
+                             std::string help) {
+  return {std::move(id), std::move(label), std::move(help), ParamType::integer, double(def), double(min), double(max), {}};
+}
+ParamSpec ParamSpec::real(std::string id, std::string label, double def, double min, double max, std::string help) {
+  return {std::move(id), std::move(label), std::move(help), ParamType::real, def, min, max, {}};
+}
+ParamSpec ParamSpec::choice(std::string id, std::string label, std::vector<std::string> choices, std::size_t def,
+                            std::string help) {
+  return {std::move(id), std::move(label), std::move(help), ParamType::choice, double(def), 0, 0, std::move(choices)};
+}
+
+namespace {
+std::string number_text(double x) {
+  char buffer[64];
+  auto [end, ec] = std::to_chars(buffer, buffer + sizeof buffer, x);
+  return ec == std::errc() ? std::string(buffer, end) : std::to_string(x);
+}
+}  // namespace
+
+std::string ParamSpec::default_text() const {
+  switch (type) {
+    case ParamType::boolean: return default_value != 0 ? "true" : "false";
+    case ParamType::integer: return std::to_string(static_cast<std::int64_t>(default_value));
+    case ParamType::real: return number_text(default_value);
+    case ParamType::choice: return choices.at(static_cast<std::size_t>(default_value));
+  }
+  return "";
+}
+
+std::string ParamSpec::range_text() const {
+  switch (type) {
+    case ParamType::boolean: return "true or false";
+    case ParamType::integer:
+      return "an integer from " + std::to_string(static_cast<std::int64_t>(min)) + " to " +
+             std::to_string(static_cast<std::int64_t>(max));
+    case ParamType::real: return "a number from " + number_text(min) + " to " + number_text(max);
+    case ParamType::choice: {
+      std::string out = "one of";
+      for (std::size_t i = 0; i < choices.size(); ++i) out += (i ? ", " : " ") + choices[i];
+      return out;
+    }
+  }
+  return "";
+}
+
+std::string value_text(const Value& value) {
+  return std::visit(
+      [](const auto& v) -> std::string {
+        using T = std::decay_t<decltype(v)>;
+        if constexpr (std::is_same_v<T, bool>) return v ? "true" : "false";
+        else if constexpr (std::is_same_v<T, std::int64_t>) return std::to_string(v);
+        else if constexpr (std::is_same_v<T, double>) return number_text(v);
+        else return v;
+      },
+      value);
+}
+
+const Value& ParamValues::at(const std::string& id) const {
+  auto it = values_.find(id);
+  if (it == values_.end()) throw Error("internal: parameter '" + id + "' was not resolved");
+  return it->second;
+}
+bool ParamValues::get_bool(const std::string& id) const { return std::get<bool>(at(id)); }
+std::int64_t ParamValues::get_int(const std::string& id) const { return std::get<std::int64_t>(at(id)); }
+double ParamValues::get_real(const std::string& id) const { return std::get<double>(at(id)); }
+const std::string& ParamValues::get_choice(const std::string& id) const { return std::get<std::string>(at(id)); }
+
+const Value* OperationReport::find(const std::string& key) const {
+  for (const auto& [k, v] : entries)
+    if (k == key) return &v;
+  return nullptr;
+}
+
+std::string OperationReport::to_text() const {
+  std::ostringstream out;
+  for (const auto& [key, value] : entries) out << key << ": " << value_text(value) << "\n";
+  for (const auto& m : messages) out << m << "\n";
+  return out.str();
+}
+
+namespace {
+std::string json_string(const std::string& s) {
+  std::string out = "\"";
+  for (char c : s) {
+    switch (c) {
+      case '"': out += "\\\""; break;
+      case '\\': out += "\\\\"; break;
+      case '\n': out += "\\n"; break;
+      case '\t': out += "\\t"; break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20) {
+          char buffer[8];
+          std::snprintf(buffer, sizeof buffer, "\\u%04x", c);
+          out += buffer;
+        } else {
+          out += c;
+        }
+    }
+  }
+  return out + "\"";
+}
+
+std::string json_value(const Value& value) {
+  if (const auto* s = std::get_if<std::string>(&value)) return json_string(*s);
+  if (const auto* d = std::get_if<double>(&value)) return std::isfinite(*d) ? number_text(*d) : "null";
+  return value_text(value);
+}
+}  // namespace
+
+std::string OperationReport::to_json() const {
+  std::string out = "{";
+  for (std::size_t i = 0; i < entries.size(); ++i)
+    out += (i ? ", " : "") + json_string(entries[i].first) + ": " + json_value(entries[i].second);
+  out += std::string(entries.empty() ? "" : ", ") + "\"messages\": [";
+  for (std::size_t i = 0; i < messages.size(); ++i) out += (i ? ", " : "") + json_string(messages[i]);
+  return out + "]}";
+}
+
+const ParamSpec* Operation::find_param(const std::string& id) const {
+  for (const auto& p : params)
+    if (p.id == id) return &p;
+  return nullptr;
+}
+
+const std::vector<Operation>& catalogue() {
+#define HEDGE_LIST_OPERATION(name) name##_operation(),
+  static const std::vector<Operation> operations = {HEDGE_OPERATIONS(HEDGE_LIST_OPERATION)};
+#undef HEDGE_LIST_OPERATION
+  return operations;
+}
+
+const Operation& find_operation(const std::string& id) {
+  for (const auto& op : catalogue())
+    if (op.id == id) return op;
+  std::string known;
+  for (const auto& op : catalogue()) known += (known.empty() ? "" : ", ") + op.id;
+  throw Error("unknown operation '" + id + "'; the operations are: " + known);
+}
+
+namespace {
+
+[[noreturn]] void refuse(const Operation& op, const ParamSpec& p, const std::string& given) {
+  throw Error(op.id + ": parameter " + p.id + " must be " + p.range_text() + ", got '" + given + "'");
+}
+
+Value check_value(const Operation& op, const ParamSpec& p, const Value& value) {
+  const std::string text = value_text(value);
+  switch (p.type) {
+    case ParamType::boolean:
+      if (const auto* b = std::get_if<bool>(&value)) return *b;
+      if (const auto* i = std::get_if<std::int64_t>(&value); i && (*i == 0 || *i == 1)) return *i == 1;
+      refuse(op, p, text);
+    case ParamType::integer: {
+      std::int64_t i = 0;
+      if (const auto* pi = std::get_if<std::int64_t>(&value)) i = *pi;
+      else if (const auto* pd = std::get_if<double>(&value); pd && std::isfinite(*pd) && std::floor(*pd) == *pd && std::fabs(*pd) < 9e15)
+        i = static_cast<std::int64_t>(*pd);
+      else refuse(op, p, text);
+      if (double(i) < p.min || double(i) > p.max) refuse(op, p, text);
+      return i;
+    }
+    case ParamType::real: {
+      double d = 0;
+      if (const auto* pd = std::get_if<double>(&value)) d = *pd;
+      else if (const auto* pi = std::get_if<std::int64_t>(&value)) d = double(*pi);
+      else refuse(op, p, text);
+      if (!std::isfinite(d) || d < p.min || d > p.max) refuse(op, p, text);
+      return d;
+    }
+    case ParamType::choice: {
+      if (const auto* s = std::get_if<std::string>(&value))
+        for (const auto& c : p.choices)
+          if (c == *s) return c;
+      if (const auto* i = std::get_if<std::int64_t>(&value); i && *i >= 0 && std::size_t(*i) < p.choices.size())
+        return p.choices[std::size_t(*i)];
+      refuse(op, p, text);
+    }
+  }
+  refuse(op, p, text);
+}
+
+Value parse_text(const Operation& op, const ParamSpec& p, const std::string& text) {
+  switch (p.type) {
+    case ParamType::boolean:
+      if (text == "true" || text == "1" || text == "yes" || text == "on") return true;
+      if (text == "false" || text == "0" || text == "no" || text == "off") return false;
+      refuse(op, p, text);
+    case ParamType::integer: {
+      std::int64_t i = 0;
+      auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), i);
+      if (ec != std::errc() || end != text.data() + text.size()) refuse(op, p, text);
+      return i;
+    }
+    case ParamType::real: {
+      double d = 0;
+      auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), d);
+      if (ec != std::errc() || end != text.data() + text.size()) refuse(op, p, text);
+      return d;
+    }
+    case ParamType::choice: return text;
+  }
+  refuse(op, p, text);
+}
+
+template <class Given, class Convert>
+ParamValues resolve(const Operation& op, const Given& given, Convert convert) {
+  for (const auto& [id, value] : given)
+    if (!op.find_param(id)) {
+      std::string known;
+      for (const auto& p : op.params) known += (known.empty() ? "" : ", ") + p.id;
+      throw Error(op.id + ": unknown parameter '" + id + "'" + (known.empty() ? "; it takes none" : "; its parameters are: " + known));
+    }
+  ParamValues values;
+  for (const auto& p : op.params) {
+    auto it = given.find(p.id);
+    Value v = it == given.end() ? parse_text(op, p, p.default_text()) : convert(p, it->second);
+    values.set(p.id, check_value(op, p, v));
+  }
+  return values;
+}
+
+}  // namespace
+
+ParamValues resolve_params(const Operation& op, const std::map<std::string, std::string>& given) {
+  return resolve(op, given, [&](const ParamSpec& p, const std::string& text) { return parse_text(op, p, text); });
+}
+
+ParamValues resolve_params(const Operation& op, const std::map<std::string, Value>& given) {
+  return resolve(op, given, [](const ParamSpec&, const Value& v) { return v; });
+}
+
+RunResult run_operation(const Operation& op, const Soup& input, const ParamValues& params, Progress& progress) {
+  using Clock = std::chrono::steady_clock;
+  auto start = Clock::now();
+  progress.update(0.0, "building the half-edge mesh");
+  BuildResult built = build(input);
+  RunResult result;
+  result.build = built.report;
+  result.report = op.run(built.mesh, params, progress);
+  if (op.changes_mesh) {
+    check_valid(built.mesh, op.id);
+    progress.update(1.0, "writing the result");
+    result.soup = extract(built.mesh);
+  }
+  double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  result.report.add("seconds", seconds);
+  for (const auto& m : built.report.messages) result.report.messages.push_back("input: " + m);
+  return result;
+}
+
+}  // namespace hedge

@@ -1,0 +1,86 @@
+// Topology counts by one pass over the elements and a union-find over vertices.
+#include "hedge/topology.h"
+
+#include <numeric>
+#include <vector>
+
+namespace hedge {
+namespace {
+
+class UnionFind {
+ public:
+  explicit UnionFind(std::size_t n) : parent_(n) { std::iota(parent_.begin(), parent_.end(), Index(0)); }
+  Index find(Index i) {
+    while (parent_[i] != i) {
+      parent_[i] = parent_[parent_[i]];
+      i = parent_[i];
+    }
+    return i;
+  }
+  void unite(Index a, Index b) {
+    a = find(a);
+    b = find(b);
+    if (a != b) parent_[std::max(a, b)] = std::min(a, b);
+  }
+
+ private:
+  std::vector<Index> parent_;
+};
+
+}  // namespace
+
+TopologyStats topology_stats(const Mesh& mesh) {
+  TopologyStats s;
+  s.vertices = mesh.n_vertices();
+  s.edges = mesh.n_edges();
+  s.faces = mesh.n_faces();
+  s.halfedges = mesh.n_halfedges();
+
+  UnionFind sets(mesh.vertices_size());
+  for (Edge e : mesh.edges()) sets.unite(mesh.vertex(e, 0).idx(), mesh.vertex(e, 1).idx());
+  for (Vertex v : mesh.vertices()) {
+    if (mesh.is_isolated(v))
+      ++s.isolated_vertices;
+    else if (sets.find(v.idx()) == v.idx())
+      ++s.components;
+  }
+
+  std::vector<bool> visited(mesh.halfedges_size(), false);
+  for (Halfedge h : mesh.halfedges()) {
+    if (!mesh.is_boundary(h)) continue;
+    ++s.boundary_edges;
+    if (visited[h.idx()]) continue;
+    ++s.boundary_loops;
+    for (Halfedge b : mesh.loop(h)) visited[b.idx()] = true;
+  }
+
+  s.euler_characteristic = static_cast<std::int64_t>(s.vertices - s.isolated_vertices) -
+                           static_cast<std::int64_t>(s.edges) + static_cast<std::int64_t>(s.faces);
+  s.genus = (2 * static_cast<std::int64_t>(s.components) - static_cast<std::int64_t>(s.boundary_loops) -
+             s.euler_characteristic) / 2;
+  return s;
+}
+
+std::size_t face_components(const Mesh& mesh, std::vector<Index>& component_of_face) {
+  component_of_face.assign(mesh.faces_size(), kInvalidIndex);
+  std::vector<Face> stack;
+  Index next_id = 0;
+  for (Face seed : mesh.faces()) {
+    if (component_of_face[seed.idx()] != kInvalidIndex) continue;
+    component_of_face[seed.idx()] = next_id;
+    stack.push_back(seed);
+    while (!stack.empty()) {
+      Face f = stack.back();
+      stack.pop_back();
+      for (Face g : mesh.faces(f))
+        if (component_of_face[g.idx()] == kInvalidIndex) {
+          component_of_face[g.idx()] = next_id;
+          stack.push_back(g);
+        }
+    }
+    ++next_id;
+  }
+  return next_id;
+}
+
+}  // namespace hedge
