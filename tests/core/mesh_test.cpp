@@ -1,0 +1,266 @@
+// Tests of the Mesh class itself: allocation, circulators, properties, deletion and
+// garbage collection. Euler operations have their own file.
+#include "hedge/mesh.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <vector>
+
+#include "hedge/topology.h"
+#include "hedge/validate.h"
+
+namespace hedge {
+namespace {
+
+// A 3x3 grid of vertices, 4 quads, counter-clockwise seen from +z.
+Mesh quad_grid() {
+  Mesh m;
+  std::vector<Vertex> v;
+  for (int y = 0; y < 3; ++y)
+    for (int x = 0; x < 3; ++x) v.push_back(m.add_vertex(Point{{float(x), float(y), 0}}));
+  for (int y = 0; y < 2; ++y)
+    for (int x = 0; x < 2; ++x) m.add_quad(v[y * 3 + x], v[y * 3 + x + 1], v[(y + 1) * 3 + x + 1], v[(y + 1) * 3 + x]);
+  return m;
+}
+
+// A closed tetrahedron.
+Mesh tetrahedron() {
+  Mesh m;
+  Vertex a = m.add_vertex(Point{{0, 0, 0}}), b = m.add_vertex(Point{{1, 0, 0}});
+  Vertex c = m.add_vertex(Point{{0, 1, 0}}), d = m.add_vertex(Point{{0, 0, 1}});
+  m.add_triangle(a, c, b);
+  m.add_triangle(a, b, d);
+  m.add_triangle(b, c, d);
+  m.add_triangle(c, a, d);
+  return m;
+}
+
+template <class Range>
+auto collect(const Range& range) {
+  std::vector<std::decay_t<decltype(*range.begin())>> out;
+  for (auto x : range) out.push_back(x);
+  return out;
+}
+
+TEST(Mesh, HandlesArePairedHalfedges) {
+  EXPECT_EQ(opposite(Halfedge(6)), Halfedge(7));
+  EXPECT_EQ(opposite(Halfedge(7)), Halfedge(6));
+  EXPECT_EQ(edge_of(Halfedge(7)), Edge(3));
+  EXPECT_EQ(halfedge_of(Edge(3), 1), Halfedge(7));
+  EXPECT_FALSE(Vertex().is_valid());
+  EXPECT_EQ(Vertex().idx(), kInvalidIndex);
+}
+
+TEST(Mesh, GridCountsAndBoundary) {
+  Mesh m = quad_grid();
+  ASSERT_TRUE(validate(m)) << validate(m).message;
+  EXPECT_EQ(m.n_vertices(), 9u);
+  EXPECT_EQ(m.n_faces(), 4u);
+  EXPECT_EQ(m.n_edges(), 12u);
+  EXPECT_EQ(m.n_halfedges(), 24u);
+  EXPECT_TRUE(m.is_quad_mesh());
+  EXPECT_FALSE(m.is_boundary(Vertex(4)));
+  for (int i : {0, 1, 2, 3, 5, 6, 7, 8}) EXPECT_TRUE(m.is_boundary(Vertex(i))) << i;
+  // A boundary vertex's halfedge is its outgoing boundary half-edge.
+  for (int i : {0, 1, 2, 3, 5, 6, 7, 8}) EXPECT_TRUE(m.is_boundary(m.halfedge(Vertex(i)))) << i;
+  TopologyStats t = topology_stats(m);
+  EXPECT_EQ(t.boundary_loops, 1u);
+  EXPECT_EQ(t.components, 1u);
+  EXPECT_EQ(t.euler_characteristic, 1);
+  EXPECT_EQ(t.genus, 0);
+}
+
+TEST(Mesh, CirculatorsAroundInteriorVertexCounterClockwise) {
+  Mesh m = quad_grid();
+  Vertex center(4);
+  auto ring = collect(m.vertices(center));
+  ASSERT_EQ(ring.size(), 4u);
+  // Counter-clockwise seen from +z: the sequence 5 -> 7 -> 3 -> 1 up to rotation.
+  std::vector<Vertex> expected = {Vertex(5), Vertex(7), Vertex(3), Vertex(1)};
+  auto start = std::find(expected.begin(), expected.end(), ring[0]);
+  ASSERT_NE(start, expected.end());
+  std::rotate(expected.begin(), start, expected.end());
+  EXPECT_EQ(ring, expected);
+  // Clockwise is the reverse order from the same start.
+  auto cw = collect(m.vertices_cw(center));
+  std::vector<Vertex> reversed = {ring[0], ring[3], ring[2], ring[1]};
+  EXPECT_EQ(cw, reversed);
+  EXPECT_EQ(collect(m.faces(center)).size(), 4u);
+  EXPECT_EQ(collect(m.edges(center)).size(), 4u);
+  EXPECT_EQ(m.valence(center), 4u);
+  for (Halfedge h : m.outgoing(center)) EXPECT_EQ(m.from_vertex(h), center);
+}
+
+TEST(Mesh, CirculatorsSkipHolesAroundBoundaryVertex) {
+  Mesh m = quad_grid();
+  Vertex corner(0), side(1);
+  EXPECT_EQ(collect(m.faces(corner)).size(), 1u);
+  EXPECT_EQ(collect(m.vertices(corner)).size(), 2u);
+  EXPECT_EQ(collect(m.faces(side)).size(), 2u);
+  EXPECT_EQ(collect(m.faces_cw(side)).size(), 2u);
+  EXPECT_EQ(m.valence(side), 3u);
+}
+
+TEST(Mesh, FaceCirculatorsStartAtCornerZero) {
+  Mesh m = quad_grid();
+  auto corners = collect(m.vertices(Face(0)));
+  EXPECT_EQ(corners, (std::vector<Vertex>{Vertex(0), Vertex(1), Vertex(4), Vertex(3)}));
+  EXPECT_EQ(collect(m.halfedges(Face(0))).size(), 4u);
+  auto reversed = collect(m.halfedges_reversed(Face(0)));
+  EXPECT_EQ(reversed.size(), 4u);
+  EXPECT_EQ(m.to_vertex(reversed[1]), Vertex(3));
+  // Face 0 (lower left) touches faces 1 (right) and 2 (above).
+  auto neighbours = collect(m.faces(Face(0)));
+  std::sort(neighbours.begin(), neighbours.end());
+  EXPECT_EQ(neighbours, (std::vector<Face>{Face(1), Face(2)}));
+  EXPECT_EQ(collect(m.edges(Face(3))).size(), 4u);
+}
+
+TEST(Mesh, IsolatedVertexHasEmptyRanges) {
+  Mesh m;
+  Vertex v = m.add_vertex(Point{{1, 2, 3}});
+  EXPECT_TRUE(m.is_isolated(v));
+  EXPECT_TRUE(m.is_boundary(v));
+  EXPECT_TRUE(collect(m.vertices(v)).empty());
+  EXPECT_TRUE(collect(m.faces(v)).empty());
+  EXPECT_EQ(m.position(v), (Point{{1, 2, 3}}));
+  EXPECT_TRUE(validate(m)) << validate(m).message;
+}
+
+TEST(Mesh, FindHalfedge) {
+  Mesh m = quad_grid();
+  Halfedge h = m.find_halfedge(Vertex(0), Vertex(1));
+  ASSERT_TRUE(h.is_valid());
+  EXPECT_EQ(m.from_vertex(h), Vertex(0));
+  EXPECT_EQ(m.to_vertex(h), Vertex(1));
+  EXPECT_FALSE(m.find_halfedge(Vertex(0), Vertex(4)).is_valid());
+  EXPECT_EQ(m.find_edge(Vertex(1), Vertex(0)), Mesh::edge(h));
+}
+
+TEST(Mesh, PropertiesFollowElements) {
+  Mesh m = quad_grid();
+  auto weight = m.add_vertex_property<float>("weight", 2.0f);
+  EXPECT_EQ(weight[Vertex(3)], 2.0f);
+  weight[Vertex(3)] = 7.0f;
+  auto same = m.get_vertex_property<float>("weight");
+  ASSERT_TRUE(same);
+  EXPECT_EQ(same[Vertex(3)], 7.0f);
+  EXPECT_FALSE(m.get_vertex_property<int>("weight"));  // wrong type is not found
+  EXPECT_THROW(m.add_vertex_property<float>("weight"), Error);
+  Vertex v = m.add_vertex(Point{});
+  EXPECT_EQ(weight[v], 2.0f);  // new elements get the default
+  auto label = m.face_property<int>("label", -1);
+  EXPECT_EQ(label[Face(2)], -1);
+  m.face_properties().remove("label");
+  EXPECT_FALSE(m.get_face_property<int>("label"));
+
+  auto* uv = m.halfedge_properties().add_channel("uv", ScalarType::f32, 2);
+  EXPECT_EQ(uv->size(), m.halfedges_size());
+  EXPECT_EQ(uv->stride(), 8u);
+}
+
+TEST(Mesh, InterpolateNumbersAndPickOthers) {
+  Mesh m;
+  for (int i = 0; i < 3; ++i) m.add_vertex(Point{{float(i), 0, 0}});
+  auto value = m.add_vertex_property<float>("value");
+  auto id = m.add_vertex_property<int>("id");
+  value[Vertex(0)] = 1;
+  value[Vertex(1)] = 3;
+  id[Vertex(0)] = 10;
+  id[Vertex(1)] = 20;
+  std::vector<Index> from = {0, 1};
+  std::vector<float> weights = {0.25f, 0.75f};
+  m.vertex_properties().interpolate(2, from, weights);
+  EXPECT_FLOAT_EQ(value[Vertex(2)], 2.5f);
+  EXPECT_EQ(id[Vertex(2)], 20);  // integers take the heaviest source
+}
+
+TEST(Mesh, DeleteFaceAndGarbageCollect) {
+  Mesh m = quad_grid();
+  auto tag = m.add_vertex_property<int>("tag");
+  for (Vertex v : m.vertices()) tag[v] = int(v.idx()) * 10;
+  m.delete_face(Face(0));
+  ASSERT_TRUE(validate(m)) << validate(m).message;
+  EXPECT_EQ(m.n_faces(), 3u);
+  EXPECT_TRUE(m.is_deleted(Vertex(0)));  // the corner vertex lost its only face
+  EXPECT_EQ(m.n_vertices(), 8u);
+  EXPECT_EQ(m.n_edges(), 10u);
+  EXPECT_TRUE(m.has_garbage());
+  std::size_t live = 0;
+  for ([[maybe_unused]] Face f : m.faces()) ++live;
+  EXPECT_EQ(live, 3u);
+
+  GarbageMaps maps = m.garbage_collect();
+  ASSERT_TRUE(validate(m)) << validate(m).message;
+  EXPECT_FALSE(m.has_garbage());
+  EXPECT_EQ(m.vertices_size(), 8u);
+  EXPECT_EQ(m.faces_size(), 3u);
+  EXPECT_EQ(maps.vertices[0], kInvalidIndex);
+  EXPECT_EQ(maps.vertices[1], 0u);  // relative order kept
+  EXPECT_EQ(maps.faces[1], 0u);
+  EXPECT_EQ(tag[Vertex(0)], 10);  // properties moved with their vertices
+  EXPECT_EQ(tag[Vertex(7)], 80);
+  EXPECT_EQ(m.position(Vertex(0)), (Point{{1, 0, 0}}));
+  EXPECT_EQ(topology_stats(m).boundary_loops, 1u);
+}
+
+TEST(Mesh, DeleteVertexRemovesItsFaces) {
+  Mesh m = quad_grid();
+  m.delete_vertex(Vertex(4));
+  ASSERT_TRUE(validate(m)) << validate(m).message;
+  EXPECT_EQ(m.n_faces(), 0u);
+  EXPECT_EQ(m.n_edges(), 0u);
+  EXPECT_EQ(m.n_vertices(), 0u);
+  m.garbage_collect();
+  EXPECT_TRUE(m.is_empty());
+  EXPECT_TRUE(validate(m)) << validate(m).message;
+}
+
+TEST(Mesh, DeleteEdgeOpensAHole) {
+  Mesh m = tetrahedron();
+  EXPECT_EQ(topology_stats(m).euler_characteristic, 2);
+  EXPECT_EQ(topology_stats(m).boundary_loops, 0u);
+  m.delete_edge(Edge(0));
+  ASSERT_TRUE(validate(m)) << validate(m).message;
+  EXPECT_EQ(m.n_faces(), 2u);
+  m.garbage_collect();
+  ASSERT_TRUE(validate(m)) << validate(m).message;
+  EXPECT_EQ(topology_stats(m).boundary_loops, 1u);
+}
+
+TEST(Mesh, CopiesAreDeep) {
+  Mesh a = quad_grid();
+  auto p = a.add_vertex_property<int>("p", 1);
+  Mesh b = a;
+  auto q = b.get_vertex_property<int>("p");
+  q[Vertex(0)] = 5;
+  EXPECT_EQ(p[Vertex(0)], 1);
+  EXPECT_EQ(b.n_faces(), a.n_faces());
+  EXPECT_TRUE(validate(b)) << validate(b).message;
+}
+
+TEST(Mesh, ValidateNamesTheBrokenInvariant) {
+  Mesh m = quad_grid();
+  Halfedge h = m.halfedge(Face(0));
+  m.set_next(h, m.next(m.next(h)));  // skip a corner: the loops no longer close properly
+  Validation v = validate(m);
+  EXPECT_FALSE(v);
+  EXPECT_NE(v.message.find("half-edge"), std::string::npos) << v.message;
+
+  Mesh n = quad_grid();
+  n.set_halfedge(Vertex(0), n.next(n.halfedge(Vertex(0))));
+  EXPECT_FALSE(validate(n));
+  EXPECT_NE(validate(n).message.find("vertex 0"), std::string::npos) << validate(n).message;
+  EXPECT_THROW(check_valid(n, "test"), Error);
+}
+
+TEST(Mesh, HeapBytesCountsArrays) {
+  Mesh m = quad_grid();
+  m.shrink_to_fit();
+  // 24 half-edges of 16 bytes, 9 vertices (4 + 12 bytes), 4 faces of 4 bytes, at least.
+  EXPECT_GE(m.heap_bytes(), 24u * 16 + 9u * 16 + 4u * 4);
+}
+
+}  // namespace
+}  // namespace hedge
