@@ -1,0 +1,79 @@
+// Shared pieces of hedge_bench: the input mesh, the heap counter, and what each library's
+// benchmarks record for the summary table printed at the end.
+#pragma once
+
+#include <benchmark/benchmark.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "hedge/soup.h"
+
+namespace bench {
+
+//! The indexed triangle soup every library builds from, read once before any timing.
+struct Input {
+  std::string path;
+  hedge::Soup soup;
+  std::size_t unique_edges = 0;  //!< undirected edges of the soup (for the peers' reserve())
+};
+const Input& input();
+void load_input(const std::string& path);
+
+//! Counts live heap bytes (malloc_usable_size of every global new/delete, plus glibc's
+//! mallinfo2 as a cross-check for memory that bypasses operator new) between construction
+//! and destruction. One window at a time.
+class HeapWindow {
+ public:
+  HeapWindow();
+  ~HeapWindow();
+  HeapWindow(const HeapWindow&) = delete;
+  HeapWindow& operator=(const HeapWindow&) = delete;
+  std::int64_t live() const;         //!< bytes allocated and not freed since the start
+  std::int64_t peak() const;         //!< the largest live() seen so far
+  std::int64_t malloc_live() const;  //!< the same from mallinfo2 (all of malloc)
+
+ private:
+  std::int64_t malloc_start_;
+};
+
+//! What a library's benchmarks found, shown in the summary.
+struct LibraryStats {
+  std::size_t vertices = 0, faces = 0;    //!< in the built mesh (peers drop non-manifold faces)
+  std::int64_t live_bytes = -1;           //!< heap held by the built mesh (default build)
+  std::int64_t peak_bytes = -1;           //!< heap peak during that build
+  std::int64_t malloc_bytes = -1;         //!< mallinfo2's view of live_bytes
+  std::int64_t reserved_live_bytes = -1;  //!< heap held when built with exact reserve()
+  std::int64_t self_reported = -1;        //!< the library's own count (hedge: Mesh::heap_bytes())
+  std::uint64_t circulation_sum = 0;      //!< checksum of the one-ring benchmark
+  std::vector<std::string> notes;
+};
+LibraryStats& stats(const std::string& library);
+
+//! One benchmark of one library. `op` is the table row (and the first part of the
+//! benchmark name, `op/library`).
+struct Entry {
+  std::string op;
+  void (*run)(benchmark::State&);
+};
+std::vector<Entry> hedge_benchmarks();
+std::vector<Entry> openmesh_benchmarks();
+std::vector<Entry> cgal_benchmarks();
+
+//! Vertex normals of the cached mesh of a library, indexed by soup vertex (for the
+//! cross-check that all libraries computed the same thing); empty when not built.
+std::vector<hedge::Vec3f> hedge_area_normals_by_soup_vertex();
+std::vector<hedge::Vec3f> openmesh_area_normals_by_soup_vertex();
+
+// Row names shared by the library files and the table.
+inline constexpr const char* kBuild = "build";
+inline constexpr const char* kBuildReserved = "build_reserved";
+inline constexpr const char* kCirculate = "circulate";
+inline constexpr const char* kNormals = "vertex_normals";
+inline constexpr const char* kNormalsLoop = "vertex_normals_loop";
+inline constexpr const char* kMemory = "memory";
+inline constexpr const char* kMemoryReserved = "memory_reserved";
+
+}  // namespace bench
