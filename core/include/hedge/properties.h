@@ -57,9 +57,13 @@ template <class T>
 struct is_vec : std::false_type {};
 template <class T, int N>
 struct is_vec<Vec<T, N>> : std::true_type {};
+// A partial specialisation, so that non-vector types never form T{}[0].
 template <class T>
-inline constexpr bool is_interpolable_v =
-    std::is_floating_point_v<T> || (is_vec<T>::value && std::is_floating_point_v<std::remove_cvref_t<decltype(T{}[0])>>);
+struct is_interpolable : std::is_floating_point<T> {};
+template <class T, int N>
+struct is_interpolable<Vec<T, N>> : std::is_floating_point<T> {};
+template <class T>
+inline constexpr bool is_interpolable_v = is_interpolable<T>::value;
 
 inline std::size_t largest_weight(std::span<const float> weights) {
   std::size_t best = 0;
