@@ -1,6 +1,5 @@
 // hedge's side of hedge_bench: build(), circulators, vertex_normals(), heap.
 #include <memory>
-#include <stdexcept>
 #include <string>
 
 #include "bench.h"
@@ -11,9 +10,6 @@
 namespace bench {
 
 namespace {
-
-#ifdef HEDGE_BENCH_HAVE_BUILD
-constexpr bool kHaveBuild = true;
 
 //! The mesh the query benchmarks use, built once.
 std::unique_ptr<hedge::BuildResult>& cache_slot() {
@@ -36,26 +32,8 @@ hedge::BuildResult& cached() {
   }
   return *result;
 }
-#else
-constexpr bool kHaveBuild = false;
-std::unique_ptr<hedge::BuildResult>& cache_slot() {
-  static std::unique_ptr<hedge::BuildResult> none;
-  return none;
-}
-hedge::BuildResult& cached() { throw std::logic_error("no build()"); }
-#endif
-
-bool need_build(benchmark::State& state) {
-  if (kHaveBuild) return true;
-  state.SkipWithError("hedge::build() is not implemented yet");
-  for (auto _ : state) {
-  }
-  return false;
-}
 
 void build(benchmark::State& state) {
-  if (!need_build(state)) return;
-#ifdef HEDGE_BENCH_HAVE_BUILD
   const hedge::Soup& soup = input().soup;
   for (auto _ : state) {
     auto result = std::make_unique<hedge::BuildResult>(hedge::build(soup));
@@ -64,11 +42,9 @@ void build(benchmark::State& state) {
     result.reset();
     state.ResumeTiming();
   }
-#endif
 }
 
 void circulate(benchmark::State& state) {
-  if (!need_build(state)) return;
   const hedge::Mesh& mesh = cached().mesh;
   std::uint64_t sum = 0;
   for (auto _ : state) {
@@ -81,7 +57,6 @@ void circulate(benchmark::State& state) {
 }
 
 void normals(benchmark::State& state) {
-  if (!need_build(state)) return;
   const hedge::Mesh& mesh = cached().mesh;
   std::vector<hedge::Vec3f> out(mesh.vertices_size());
   for (auto _ : state) {
@@ -91,8 +66,6 @@ void normals(benchmark::State& state) {
 }
 
 void memory(benchmark::State& state) {
-  if (!need_build(state)) return;
-#ifdef HEDGE_BENCH_HAVE_BUILD
   LibraryStats& s = stats("hedge");
   for (auto _ : state) {
     HeapWindow heap;
@@ -124,7 +97,6 @@ void memory(benchmark::State& state) {
   }
   state.counters["MB"] = static_cast<double>(s.live_bytes) / (1 << 20);
   state.counters["bytes_per_face"] = static_cast<double>(s.live_bytes) / static_cast<double>(s.faces);
-#endif
 }
 
 }  // namespace

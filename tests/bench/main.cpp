@@ -221,8 +221,9 @@ void print_summary() {
   std::printf("\n== hedge_bench summary: %s (%zu vertices, %zu faces in the soup) ==\n",
               std::filesystem::path(in.path).filename().c_str(), in.soup.n_vertices(), in.soup.n_faces());
   for (bool cpu : {false, true}) {
-    std::printf(cpu ? "\nthe same, CPU time of the process, all its threads (less sensitive to other load on the machine)\n"
-                    : "times: minimum over repetitions, wall clock, ms; ratios are peer/hedge (>1: hedge faster)\n");
+    std::printf(
+        cpu ? "\nthe same, CPU time of the process, all its threads (less sensitive to other load on the machine)\n"
+            : "times: minimum over repetitions, wall clock, ms; ratios are peer/hedge (>1: hedge faster)\n");
     std::printf("%-32s %10s %10s %10s %14s %12s\n", "operation", "hedge", "OpenMesh", "CGAL", "OpenMesh/hedge",
                 "CGAL/hedge");
     for (const std::string& op : g_ops) {
