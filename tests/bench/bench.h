@@ -22,6 +22,16 @@ struct Input {
 const Input& input();
 void load_input(const std::string& path);
 
+//! True when a face visits a vertex twice. Such faces are not offered to the peers: the
+//! Debian OpenMesh is built with assertions on and aborts on them (CGAL would refuse them).
+inline bool repeats_vertex(const std::uint32_t* corners, std::uint32_t n) {
+  if (n == 3) return corners[0] == corners[1] || corners[1] == corners[2] || corners[0] == corners[2];
+  for (std::uint32_t i = 0; i < n; ++i)
+    for (std::uint32_t j = 0; j < i; ++j)
+      if (corners[i] == corners[j]) return true;
+  return false;
+}
+
 //! Counts live heap bytes (malloc_usable_size of every global new/delete, plus glibc's
 //! mallinfo2 as a cross-check for memory that bypasses operator new) between construction
 //! and destruction. One window at a time.

@@ -75,7 +75,8 @@ void memory(benchmark::State& state) {
       s.peak_bytes = heap.peak();
       const std::int64_t with_maps = heap.live();
       mesh = std::move(result.mesh);
-      s.notes.push_back("BuildResult (mesh + report + maps) held " + std::to_string(with_maps >> 20) + " MB");
+      s.notes.push_back("BuildResult (mesh + report + maps) held " +
+                        std::to_string(with_maps / 100000 / 10.0).substr(0, 5) + " MB");
     }
     // The mesh alone: what stays after the caller drops the report and the maps.
     s.live_bytes = heap.live();
@@ -95,7 +96,7 @@ void memory(benchmark::State& state) {
     list("f", mesh.face_properties());
     if (!props.empty()) s.notes.push_back("mesh properties after build:" + props);
   }
-  state.counters["MB"] = static_cast<double>(s.live_bytes) / (1 << 20);
+  state.counters["MB"] = static_cast<double>(s.live_bytes) / 1e6;
   state.counters["bytes_per_face"] = static_cast<double>(s.live_bytes) / static_cast<double>(s.faces);
 }
 

@@ -191,7 +191,8 @@ std::string cell_ms(const std::string& key, bool cpu) {
   if (it == g_timings.end()) return "-";
   if (!it->second.error.empty()) return "n/a";
   char buf[32];
-  std::snprintf(buf, sizeof buf, "%.1f", ms_of(key, cpu));
+  const double ms = ms_of(key, cpu);
+  std::snprintf(buf, sizeof buf, ms < 10 ? "%.2f" : "%.1f", ms);
   return buf;
 }
 
@@ -205,7 +206,7 @@ std::string ratio(double num, double den) {
 std::string mb(std::int64_t bytes) {
   if (bytes < 0) return "-";
   char buf[32];
-  std::snprintf(buf, sizeof buf, "%.1f", static_cast<double>(bytes) / (1 << 20));
+  std::snprintf(buf, sizeof buf, "%.1f", static_cast<double>(bytes) / 1e6);
   return buf;
 }
 
@@ -241,7 +242,15 @@ void print_summary() {
   }
 
   const LibraryStats &hs = stats("hedge"), &os = stats("OpenMesh"), &cs = stats("CGAL");
-  std::printf("\nheap held by the built mesh (live bytes after build minus before; bytes per face kept)\n");
+  for (const auto& [key, t] : g_timings) {
+    if (t.error.empty() && t.cpu_min_ms > 1.2 * t.min_ms)
+      std::printf("note: %s ran on more than one thread (CPU time %.1f ms over %.1f ms of wall clock)\n", key.c_str(),
+                  t.cpu_min_ms, t.min_ms);
+  }
+
+  std::printf(
+      "\nheap held by the built mesh (live bytes after build minus before, MB = 10^6 bytes; bytes per face "
+      "kept)\n");
   std::printf("%-32s %10s %10s %10s %14s %12s\n", "", "hedge", "OpenMesh", "CGAL", "hedge/OpenMesh", "hedge/CGAL");
   auto mem_row = [&](const char* title, std::int64_t h, std::int64_t o, std::int64_t c, bool per) {
     if (h < 0 && o < 0 && c < 0) return;
@@ -272,7 +281,7 @@ void print_summary() {
     if (s.faces == in.soup.n_faces()) {
       std::printf(" (every face of the soup)");
     } else if (s.faces < in.soup.n_faces()) {
-      std::printf(" (%zu faces dropped)", in.soup.n_faces() - s.faces);
+      std::printf(" (%zu soup faces not built)", in.soup.n_faces() - s.faces);
     } else if (s.faces) {
       std::printf(" (%zu faces more than the soup)", s.faces - in.soup.n_faces());
     }
@@ -307,7 +316,7 @@ void usage() {
       "hedge_bench [--meshes DIR] [--mesh FILE] [--reps N] [benchmark flags]\n"
       "  --meshes DIR   directory of the fetched meshes (default build/meshes)\n"
       "  --mesh FILE    the mesh to use; a bare name is looked up in DIR (default dragon.ply)\n"
-      "  --reps N       repetitions per benchmark; the table shows their minimum (default 5)\n");
+      "  --reps N       repetitions per benchmark; the table shows their minimum (default 10)\n");
   benchmark::PrintDefaultHelp();
 }
 
@@ -317,7 +326,7 @@ double min_statistic(const std::vector<double>& v) { return bench::min_of(v); }
 
 int main(int argc, char** argv) {
   std::string dir = "build/meshes", mesh = "dragon.ply";
-  int reps = 5;
+  int reps = 10;
   std::vector<char*> rest = {argv[0]};
   for (int i = 1; i < argc; ++i) {
     std::string a = argv[i];
