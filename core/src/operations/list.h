@@ -3,4 +3,5 @@
 #pragma once
 
 #define HEDGE_OPERATIONS(X) \
-  X(report)
+  X(report)             \
+  X(subdivide)

@@ -1,0 +1,68 @@
+// Subdivision surfaces: Loop, Catmull–Clark, √3 and midpoint refinement. Each step builds
+// the refined mesh directly into fresh arrays and carries every vertex, corner and face attribute.
+#pragma once
+
+#include <cstddef>
+#include <string>
+
+#include "hedge/catalogue.h"
+#include "hedge/mesh.h"
+#include "hedge/progress.h"
+
+namespace hedge {
+
+enum class SubdivisionScheme {
+  loop,           //!< Loop 1987: triangles 1 -> 4, C2 box-spline stencils (triangle meshes only)
+  catmull_clark,  //!< Catmull & Clark 1978: every n-gon -> n quads (any polygon mesh)
+  sqrt3,          //!< Kobbelt 2000: 1 -> 3 split at the centroid, then flip the old edges (triangle meshes only)
+  midpoint,       //!< linear: triangles 1 -> 4 at edge midpoints, n-gons -> n quads at the centroid
+};
+
+//! "loop", "catmull_clark", "sqrt3", "midpoint"; throws Error naming the choices otherwise.
+SubdivisionScheme subdivision_scheme_from_name(const std::string& name);
+const char* subdivision_scheme_name(SubdivisionScheme scheme);
+
+struct SubdivideOptions {
+  SubdivisionScheme scheme = SubdivisionScheme::loop;
+  int iterations = 1;                   //!< refinement steps, 1 or more
+  std::size_t max_faces = 200'000'000;  //!< refuse (before starting) results larger than this
+  unsigned threads = 2;                 //!< for the stencils and the connectivity of big meshes
+};
+
+struct SubdivideReport {
+  std::size_t vertices = 0, edges = 0, faces = 0;  //!< of the result
+  int iterations = 0;
+};
+
+//! Face count after `options.iterations` steps of `options.scheme`, without refining.
+//! Precondition for loop and sqrt3: a triangle mesh.
+std::size_t subdivided_face_count(const Mesh& mesh, const SubdivideOptions& options);
+
+//! Refines the mesh `options.iterations` times.
+//!
+//! Preconditions: loop and sqrt3 need a triangle mesh (Error otherwise: triangulate first);
+//! catmull_clark and midpoint take any polygon mesh. Boundaries follow each scheme's
+//! boundary rules: Loop and Catmull–Clark move boundary vertices by the cubic B-spline
+//! curve rule (1/8, 6/8, 1/8) and put boundary edge points at the midpoints, so a boundary
+//! is a curve refined on its own; √3 keeps boundary edges and vertices as they are (a
+//! documented simplification of Kobbelt's two-step boundary rule).
+//!
+//! Attributes: vertex properties are blended with the same stencils as positions (integer
+//! channels take the value of the heaviest source); corner properties are blended
+//! linearly inside each old face (midpoints, centroids), so seams stay seams; face
+//! properties are copied to the child faces; edge properties are copied to the two halves of
+//! a split edge. The mesh's own "hedge:" bookkeeping is copied for continuing elements and
+//! left at its default for new ones (a new vertex has no source vertex).
+//!
+//! Numbering (on a mesh without deleted elements): old vertices keep their indices; loop,
+//! catmull_clark and midpoint put the point of edge e at vertex V + e and face points after
+//! those, in face order; sqrt3 puts the point of face f at V + f.
+//!
+//! Throws Error, leaving the mesh untouched, for polygons under loop/sqrt3 and results above
+//! options.max_faces; Cancelled through progress likewise.
+SubdivideReport subdivide(Mesh& mesh, const SubdivideOptions& options, Progress& progress = Progress::none());
+
+//! The catalogue entry "subdivide" (parameters scheme, iterations).
+Operation subdivide_operation();
+
+}  // namespace hedge

@@ -1,0 +1,875 @@
+// Subdivision surfaces (subdivide.h). Every step writes the refined mesh into fresh arrays:
+// each child half-edge, edge and face has an index computed from its parent's, so building
+// the connectivity needs no search and no Euler operation, and the stencils run on two threads.
+#include "hedge/subdivide.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <exception>
+#include <limits>
+#include <numbers>
+#include <thread>
+#include <typeinfo>
+#include <vector>
+
+#include "hedge/error.h"
+
+namespace hedge {
+namespace {
+
+// ---- tools --------------------------------------------------------------------------------
+
+//! Runs fn(begin, end) over [0, n) split across up to `threads` threads; small ranges stay on
+//! the calling thread, where a thread would cost more than it saves.
+template <class Fn>
+void parallel_for(std::size_t n, unsigned threads, Fn&& fn) {
+  constexpr std::size_t kGrain = 32768;
+  std::size_t t = std::min<std::size_t>(std::max(threads, 1u), std::max<std::size_t>(1, n / kGrain));
+  if (t <= 1) {
+    fn(std::size_t(0), n);
+    return;
+  }
+  std::vector<std::thread> pool;
+  std::vector<std::exception_ptr> errors(t);
+  for (std::size_t k = 1; k < t; ++k)
+    pool.emplace_back([&, k] {
+      try {
+        fn(n * k / t, n * (k + 1) / t);
+      } catch (...) {
+        errors[k] = std::current_exception();
+      }
+    });
+  try {
+    fn(std::size_t(0), n / t);
+  } catch (...) {
+    errors[0] = std::current_exception();
+  }
+  for (auto& th : pool) th.join();
+  for (auto& e : errors)
+    if (e) std::rethrow_exception(e);
+}
+
+//! One subdivision stencil: the new value is sum weight[i] * old[index[i]]. Rings up to 32
+//! neighbours stay in the object; bigger ones spill to the heap.
+class Stencil {
+ public:
+  Stencil() = default;
+  Stencil(const Stencil&) = delete;
+  Stencil& operator=(const Stencil&) = delete;
+  void clear() { size_ = 0; }
+  void add(Index i, float w) {
+    if (size_ == capacity_) grow();
+    index_[size_] = i;
+    weight_[size_] = w;
+    ++size_;
+  }
+  std::size_t size() const { return size_; }
+  std::span<const Index> index() const { return {index_, size_}; }
+  std::span<const float> weight() const { return {weight_, size_}; }
+  Index index(std::size_t i) const { return index_[i]; }
+  float& weight(std::size_t i) { return weight_[i]; }
+  float weight(std::size_t i) const { return weight_[i]; }
+
+ private:
+  void grow() {
+    capacity_ *= 2;
+    std::vector<Index> index(capacity_);
+    std::vector<float> weight(capacity_);
+    std::copy(index_, index_ + size_, index.begin());
+    std::copy(weight_, weight_ + size_, weight.begin());
+    heap_index_.swap(index);
+    heap_weight_.swap(weight);
+    index_ = heap_index_.data();
+    weight_ = heap_weight_.data();
+  }
+  static constexpr std::size_t kInline = 64;
+  Index inline_index_[kInline];
+  float inline_weight_[kInline];
+  std::vector<Index> heap_index_;
+  std::vector<float> heap_weight_;
+  Index* index_ = inline_index_;
+  float* weight_ = inline_weight_;
+  std::size_t size_ = 0, capacity_ = kInline;
+};
+
+bool is_internal(const PropertyArray& a) { return a.name().starts_with("hedge:"); }
+
+//! A property array with its fast path resolved once (f32 host channels are the common case
+//! and the generic interpolate() allocates per call).
+struct Target {
+  PropertyArray* array = nullptr;
+  ChannelArray* f32 = nullptr;
+  bool internal = false;
+};
+
+std::vector<Target> targets(PropertyContainer& c) {
+  std::vector<Target> out;
+  for (std::size_t i = 0; i < c.count(); ++i) {
+    Target t;
+    t.array = &c.at(i);
+    t.internal = is_internal(*t.array);
+    if (t.array->type() == typeid(ChannelArray)) {
+      auto* ch = static_cast<ChannelArray*>(t.array);
+      if (ch->scalar() == ScalarType::f32 && ch->components() <= 16) t.f32 = ch;
+    }
+    out.push_back(t);
+  }
+  return out;
+}
+
+void blend(const Target& t, std::size_t to, std::span<const Index> index, std::span<const float> weight) {
+  if (t.f32) {
+    const int k = t.f32->components();
+    double sum[16] = {};
+    float value[16];
+    for (std::size_t i = 0; i < index.size(); ++i) {
+      std::memcpy(value, t.f32->element(index[i]), sizeof(float) * std::size_t(k));
+      for (int c = 0; c < k; ++c) sum[c] += double(value[c]) * weight[i];
+    }
+    for (int c = 0; c < k; ++c) value[c] = float(sum[c]);
+    std::memcpy(t.f32->element(to), value, sizeof(float) * std::size_t(k));
+    return;
+  }
+  t.array->interpolate(to, index, weight);
+}
+
+// Half-edge h (edge e, side s) is cut at the edge point into first(h) (from its origin to
+// the edge point) and second(h) (from the edge point to its target). The halves of edge e are
+// new edges 2e (at vertex(e, 1), the origin of side 0) and 2e + 1.
+constexpr Halfedge first_half(Halfedge h) { return Halfedge((h.idx() & 1u) ? 2 * h.idx() + 1 : 2 * h.idx()); }
+constexpr Halfedge second_half(Halfedge h) { return Halfedge((h.idx() & 1u) ? 2 * h.idx() - 1 : 2 * h.idx() + 2); }
+
+void check_index_range(std::size_t vertices, std::size_t edges, std::size_t faces) {
+  const std::size_t limit = std::numeric_limits<Index>::max() - 1;
+  if (vertices > limit || 2 * edges > limit || faces > limit)
+    throw Error("subdivide: the result would have more elements than 32-bit indices can number");
+}
+
+double loop_beta_formula(std::size_t n) {
+  const double c = 3.0 / 8.0 + 0.25 * std::cos(2.0 * std::numbers::pi / double(n));
+  return (5.0 / 8.0 - c * c) / double(n);
+}
+
+//! Loop's beta(n) = (5/8 - (3/8 + cos(2 pi / n) / 4)^2) / n; common valences from a table.
+double loop_beta(std::size_t n) {
+  static const auto table = [] {
+    std::array<double, 33> t{};
+    for (std::size_t k = 1; k < t.size(); ++k) t[k] = loop_beta_formula(k);
+    return t;
+  }();
+  return n < table.size() ? table[n] : loop_beta_formula(n);
+}
+
+//! New vertices of a step: old vertices keep their indices, added vertices follow at
+//! V, V+1, ... Stencils index old vertices (< V) by their old values and added vertices by
+//! their new ones, so added vertices are computed in `phases` (ranges of added indices, in
+//! order) before the old vertices' stencils that may read them.
+struct VertexRule {
+  Index V = 0, added = 0;
+  std::vector<std::pair<Index, Index>> phases;  // [begin, end) of added indices
+};
+
+//! Positions and vertex properties of a step. added(k, stencil) and even(v, stencil) fill the
+//! stencils of added vertex k and old vertex v.
+template <class Added, class Even>
+void refine_vertices(const Mesh& m, Mesh& out, const VertexRule& rule, unsigned threads, Added added, Even even) {
+  const Index V = rule.V, N = rule.added;
+  const std::vector<Point>& old_p = m.positions();
+  std::vector<Point>& p = out.positions();
+  auto position = [&](const Stencil& s) {
+    float x = 0, y = 0, z = 0;
+    for (std::size_t i = 0; i < s.size(); ++i) {
+      const Index j = s.index(i);
+      const Point& q = j < V ? old_p[j] : p[j];
+      const float w = s.weight(i);
+      x += w * q[0];
+      y += w * q[1];
+      z += w * q[2];
+    }
+    return Point{{x, y, z}};
+  };
+  for (auto [b, e] : rule.phases)
+    parallel_for(e - b, threads, [&](std::size_t lo, std::size_t hi) {
+      Stencil s;
+      for (std::size_t k = b + lo; k < b + hi; ++k) {
+        s.clear();
+        added(Index(k), s);
+        p[V + k] = position(s);
+      }
+    });
+  parallel_for(V, threads, [&](std::size_t lo, std::size_t hi) {
+    Stencil s;
+    for (std::size_t v = lo; v < hi; ++v) {
+      s.clear();
+      even(Vertex(Index(v)), s);
+      p[v] = position(s);
+    }
+  });
+
+  // Properties: slots [0, V) old values, [V, V + N) the added vertices, [V + N, 2V + N) the old
+  // vertices' new values; the final order is a gather.
+  PropertyContainer props = m.vertex_properties();
+  if (props.count()) {
+    props.resize(std::size_t(2) * V + N);
+    std::vector<Target> all = targets(props);
+    for (auto [b, e] : rule.phases)
+      parallel_for(e - b, threads, [&](std::size_t lo, std::size_t hi) {
+        Stencil s;
+        for (std::size_t k = b + lo; k < b + hi; ++k) {
+          s.clear();
+          added(Index(k), s);
+          for (const Target& t : all)
+            if (!t.internal) blend(t, V + k, s.index(), s.weight());  // new vertices: no bookkeeping
+        }
+      });
+    parallel_for(V, threads, [&](std::size_t lo, std::size_t hi) {
+      Stencil s;
+      for (std::size_t v = lo; v < hi; ++v) {
+        s.clear();
+        even(Vertex(Index(v)), s);
+        for (const Target& t : all) {
+          if (t.internal)
+            t.array->copy_element(v, V + N + v);
+          else
+            blend(t, V + N + v, s.index(), s.weight());
+        }
+      }
+    });
+    std::vector<Index> order(std::size_t(V) + N);
+    for (Index v = 0; v < V; ++v) order[v] = V + N + v;
+    for (Index k = 0; k < N; ++k) order[V + k] = V + k;
+    props.permute(order);
+  } else {
+    props.resize(std::size_t(V) + N);
+  }
+  out.vertex_properties() = std::move(props);
+}
+
+//! Corner properties: slots [0, H) the old corners, then `extra` slots filled by fill(slot
+//! offset, array) for blended corners; the new half-edges gather from `map`.
+template <class Fill>
+void refine_corners(const Mesh& m, Mesh& out, std::size_t extra, const std::vector<Index>& map, unsigned threads,
+                    Fill fill) {
+  PropertyContainer props = m.halfedge_properties();
+  if (props.count()) {
+    const std::size_t H = m.halfedges_size();
+    props.resize(H + extra + 1);  // the last slot keeps the defaults (boundary corners)
+    std::vector<Target> all = targets(props);
+    std::vector<Target> blended;
+    for (const Target& t : all)
+      if (!t.internal) blended.push_back(t);
+    if (!blended.empty()) fill(blended, threads);
+    props.permute(map);
+  } else {
+    props.resize(out.halfedges_size());
+  }
+  out.halfedge_properties() = std::move(props);
+}
+
+void copy_parents(PropertyContainer from, PropertyContainer& to, std::size_t default_slot,
+                  const std::vector<Index>& map, std::size_t size) {
+  if (from.count()) {
+    from.resize(default_slot + 1);
+    from.permute(map);
+  } else {
+    from.resize(size);
+  }
+  to = std::move(from);
+}
+
+// ---- Loop, Catmull–Clark, midpoint: split every edge, split every face ----------------------
+
+//! Number of corners of f, walking the loop directly (hot: called for every face).
+inline Index face_size(const Mesh& m, Face f) {
+  const Halfedge start = m.halfedge(f);
+  Index n = 1;
+  for (Halfedge h = m.next(start); h != start; h = m.next(h)) ++n;
+  return n;
+}
+
+//! How each face splits: triangles of Loop and midpoint 1 -> 4 at the edge points; faces of
+//! Catmull–Clark and polygons of midpoint into one quad per corner around a face point.
+//! On a mesh of triangles split 1 -> 4 (every Loop step) the offsets are arithmetic and no
+//! table is built.
+struct SplitPlan {
+  bool uniform = false;  // all faces are triangles split 1 -> 4
+  std::vector<Index>
+      face_point;  // per face: index of its face point among the added vertices after the edge points, or invalid
+  std::vector<Index> inner_edge;  // per face: first of its new interior edges (counted after the 2E halves)
+  std::vector<Index> child_face;  // per face: first child face
+  std::vector<Index> face_of_point;
+  Index inner_edges = 0, child_faces = 0;
+
+  Index first_inner_edge(Index f) const { return uniform ? 3 * f : inner_edge[f]; }
+  Index first_child(Index f) const { return uniform ? 4 * f : child_face[f]; }
+  Index point_of_face(Index f) const { return uniform ? kInvalidIndex : face_point[f]; }
+};
+
+SplitPlan plan_split(const Mesh& m, SubdivisionScheme scheme) {
+  const std::size_t F = m.faces_size();
+  SplitPlan plan;
+  if (scheme != SubdivisionScheme::catmull_clark) {
+    bool any_polygon = false;
+    for (Index f = 0; f < F && !any_polygon; ++f) {
+      const Halfedge h = m.halfedge(Face(f));
+      any_polygon = m.next(m.next(m.next(h))) != h;
+    }
+    plan.uniform = !any_polygon;
+  }
+  if (plan.uniform) {
+    check_index_range(m.vertices_size() + m.edges_size(), 2 * m.edges_size() + 3 * F, 4 * F);
+    plan.inner_edges = Index(3 * F);
+    plan.child_faces = Index(4 * F);
+    return plan;
+  }
+  plan.face_point.resize(F);
+  plan.inner_edge.resize(F);
+  plan.child_face.resize(F);
+  std::size_t inner = 0, children = 0;
+  for (Index f = 0; f < F; ++f) {
+    const std::size_t n = face_size(m, Face(f));
+    const bool quads = scheme == SubdivisionScheme::catmull_clark || n != 3;
+    plan.inner_edge[f] = Index(inner);
+    plan.child_face[f] = Index(children);
+    if (quads) {
+      plan.face_point[f] = Index(plan.face_of_point.size());
+      plan.face_of_point.push_back(f);
+      inner += n;
+      children += n;
+    } else {
+      plan.face_point[f] = kInvalidIndex;
+      inner += 3;
+      children += 4;
+    }
+  }
+  check_index_range(m.vertices_size() + m.edges_size() + plan.face_of_point.size(), 2 * m.edges_size() + inner,
+                    children);
+  plan.inner_edges = Index(inner);
+  plan.child_faces = Index(children);
+  return plan;
+}
+
+Mesh split_step(const Mesh& m, SubdivisionScheme scheme, unsigned threads, Progress& progress, double from, double to) {
+  const Index V = Index(m.vertices_size()), E = Index(m.edges_size()), F = Index(m.faces_size());
+  const Index H = 2 * E;
+  const SplitPlan plan = plan_split(m, scheme);
+  const Index FP = Index(plan.face_of_point.size());
+  const Index V2 = V + E + FP, E2 = 2 * E + plan.inner_edges, F2 = plan.child_faces;
+
+  Mesh out;
+  out.resize(V2, E2, F2);
+  const bool corner_props = m.halfedge_properties().count() > 0;
+  const bool edge_props = m.edge_properties().count() > 0;
+  const bool face_props = m.face_properties().count() > 0;
+  // New half-edge -> corner slot (see refine_corners), new edge -> old edge, child -> parent face.
+  std::vector<Index> hmap(corner_props ? std::size_t(2) * E2 : 0), emap(edge_props ? E2 : 0), fmap(face_props ? F2 : 0);
+  const Index centroid_slot = 2 * H, default_corner = 2 * H + FP;
+
+  // Faces: the halves of their half-edges, the interior edges and the child faces.
+  // h[i] points to corner c_i; m_i is the edge point of h[i] (between c_{i-1} and c_i).
+  auto split_face = [&](Index f, const Halfedge* h, Index n) {
+    const Index ff = plan.first_child(f), ie = 2 * E + plan.first_inner_edge(f);
+    auto inner = [&](Index k, unsigned side) { return Halfedge(2 * (ie + k % n) + side); };
+    for (Index i = 0; i < n; ++i) {
+      out.set_vertex(first_half(h[i]), Vertex(V + Mesh::edge(h[i]).idx()));
+      out.set_vertex(second_half(h[i]), m.to_vertex(h[i]));
+      if (corner_props) {
+        hmap[second_half(h[i]).idx()] = h[i].idx();
+        hmap[first_half(h[i]).idx()] = H + h[i].idx();
+      }
+    }
+    const Index point = plan.point_of_face(f);
+    if (point == kInvalidIndex) {
+      // Corner triangle i: c_i, m_{i+1}, m_i; centre triangle m_0, m_1, m_2. Interior edge i
+      // joins m_{i+1} and m_i; its side 0 lies in corner triangle i, side 1 in the centre.
+      const Face centre(ff + 3);
+      for (Index i = 0; i < 3; ++i) {
+        const Index j = i == 2 ? 0 : i + 1;
+        const Halfedge a = second_half(h[i]), b = first_half(h[j]), c = inner(i, 0), d = inner(i, 1);
+        const Face t(ff + i);
+        out.set_next(a, b);
+        out.set_next(b, c);
+        out.set_next(c, a);
+        out.set_face(a, t);
+        out.set_face(b, t);
+        out.set_face(c, t);
+        out.set_halfedge(t, a);
+        out.set_vertex(c, Vertex(V + Mesh::edge(h[i]).idx()));
+        out.set_vertex(d, Vertex(V + Mesh::edge(h[j]).idx()));
+        out.set_face(d, centre);
+        out.set_next(d, inner(j, 1));
+        if (corner_props) {
+          hmap[c.idx()] = H + h[i].idx();
+          hmap[d.idx()] = H + h[j].idx();
+        }
+      }
+      out.set_halfedge(centre, inner(2, 1));
+      if (face_props)
+        for (Index c = 0; c < 4; ++c) fmap[ff + c] = f;
+    } else {
+      // Quad i: c_i, m_{i+1}, face point, m_i. Interior edge k joins the face point and m_k;
+      // its side 0 runs face point -> m_k.
+      const Vertex fp(V + E + point);
+      for (Index i = 0; i < n; ++i) {
+        const Halfedge a = second_half(h[i]), b = first_half(h[(i + 1) % n]), c = inner(i + 1, 1), d = inner(i, 0);
+        const Face t(ff + i);
+        out.set_next(a, b);
+        out.set_next(b, c);
+        out.set_next(c, d);
+        out.set_next(d, a);
+        out.set_face(a, t);
+        out.set_face(b, t);
+        out.set_face(c, t);
+        out.set_face(d, t);
+        out.set_halfedge(t, a);
+        out.set_vertex(d, Vertex(V + Mesh::edge(h[i]).idx()));
+        out.set_vertex(inner(i, 1), fp);
+        if (corner_props) {
+          hmap[d.idx()] = H + h[i].idx();
+          hmap[inner(i, 1).idx()] = centroid_slot + point;
+        }
+        if (face_props) fmap[ff + i] = f;
+      }
+      out.set_halfedge(fp, inner(0, 0));
+    }
+    if (edge_props)
+      for (Index k = 0; k < (point == kInvalidIndex ? 3 : n); ++k) emap[ie + k] = E;  // interior edges: defaults
+  };
+  parallel_for(F, threads, [&](std::size_t lo, std::size_t hi) {
+    std::vector<Halfedge> loop;
+    for (Index f = Index(lo); f < hi; ++f) {
+      const Halfedge h0 = m.halfedge(Face(f)), h1 = m.next(h0), h2 = m.next(h1);
+      if (m.next(h2) == h0) {
+        const Halfedge h[3] = {h0, h1, h2};
+        split_face(f, h, 3);
+      } else {
+        loop.clear();
+        for (Halfedge x : m.halfedges(Face(f))) loop.push_back(x);
+        split_face(f, loop.data(), Index(loop.size()));
+      }
+    }
+  });
+  progress.update(from + 0.3 * (to - from), "subdividing: connectivity");
+
+  // Edges: boundary half-edges split in two along their hole; edge points' half-edges.
+  parallel_for(E, threads, [&](std::size_t lo, std::size_t hi) {
+    for (Index e = Index(lo); e < hi; ++e) {
+      const Vertex mid(V + e);
+      for (unsigned side = 0; side < 2; ++side) {
+        const Halfedge h = Mesh::halfedge(Edge(e), side);
+        if (!m.is_boundary(h)) continue;
+        out.set_vertex(first_half(h), mid);
+        out.set_vertex(second_half(h), m.to_vertex(h));
+        out.set_next(first_half(h), second_half(h));
+        out.set_next(second_half(h), first_half(m.next(h)));
+        if (corner_props) {
+          hmap[first_half(h).idx()] = default_corner;
+          hmap[second_half(h).idx()] = h.idx();
+        }
+      }
+      const Halfedge h0 = Mesh::halfedge(Edge(e), 0), h1 = Mesh::halfedge(Edge(e), 1);
+      out.set_halfedge(mid, second_half(m.is_boundary(h1) ? h1 : h0));
+      if (edge_props) emap[2 * e] = emap[2 * e + 1] = e;
+    }
+  });
+  for (Index v = 0; v < V; ++v) {
+    const Halfedge h = m.halfedge(Vertex(v));
+    out.set_halfedge(Vertex(v), h.is_valid() ? first_half(h) : Halfedge());
+  }
+
+  // Stencils. Added vertices: edge points 0..E-1, then face points E..E+FP-1.
+  VertexRule rule;
+  rule.V = V;
+  rule.added = E + FP;
+  rule.phases = {{E, E + FP}, {0, E}};  // edge points of Catmull–Clark read face points
+  auto face_point_index = [&](Face f) { return V + E + plan.point_of_face(f.idx()); };
+  auto added = [&](Index k, Stencil& s) {
+    if (k >= E) {
+      const Face f(plan.face_of_point[k - E]);
+      const float w = 1.0f / float(face_size(m, f));
+      for (Vertex c : m.vertices(f)) s.add(c.idx(), w);
+      return;
+    }
+    const Halfedge h0 = Mesh::halfedge(Edge(k), 0), h1 = Mesh::halfedge(Edge(k), 1);
+    const Index a = m.to_vertex(h0).idx(), b = m.to_vertex(h1).idx();
+    if (scheme == SubdivisionScheme::midpoint || m.is_boundary(Edge(k))) {
+      s.add(a, 0.5f);
+      s.add(b, 0.5f);
+    } else if (scheme == SubdivisionScheme::loop) {
+      s.add(a, 0.375f);
+      s.add(b, 0.375f);
+      s.add(m.to_vertex(m.next(h0)).idx(), 0.125f);
+      s.add(m.to_vertex(m.next(h1)).idx(), 0.125f);
+    } else {
+      s.add(a, 0.25f);
+      s.add(b, 0.25f);
+      s.add(face_point_index(m.face(h0)), 0.25f);
+      s.add(face_point_index(m.face(h1)), 0.25f);
+    }
+  };
+  auto even = [&](Vertex v, Stencil& s) {
+    const Halfedge out_h = m.halfedge(v);
+    if (scheme == SubdivisionScheme::midpoint || !out_h.is_valid()) {
+      s.add(v.idx(), 1.0f);
+      return;
+    }
+    if (m.is_boundary(out_h)) {
+      // Cubic B-spline on the boundary curve: the two boundary neighbours 1/8 each.
+      s.add(v.idx(), 0.75f);
+      s.add(m.to_vertex(out_h).idx(), 0.125f);
+      s.add(m.from_vertex(m.prev(out_h)).idx(), 0.125f);
+      return;
+    }
+    // One walk around v gathers the ring; the weights depend on its size, set afterwards.
+    s.add(v.idx(), 0.0f);
+    if (scheme == SubdivisionScheme::loop) {
+      for (Halfedge h : m.outgoing(v)) s.add(m.to_vertex(h).idx(), 0.0f);
+      const std::size_t n = s.size() - 1;
+      const float beta = float(loop_beta(n));
+      s.weight(0) = float(1.0 - double(n) * double(beta));
+      for (std::size_t i = 1; i <= n; ++i) s.weight(i) = beta;
+    } else {
+      // (Q + 2R + (n - 3) S) / n with Q the mean face point, R the mean edge midpoint: the
+      // vertex keeps (n - 2) / n, each neighbour and face point 1 / n^2.
+      for (Halfedge h : m.outgoing(v)) {
+        s.add(m.to_vertex(h).idx(), 0.0f);
+        s.add(face_point_index(m.face(h)), 0.0f);
+      }
+      const std::size_t n = (s.size() - 1) / 2;
+      s.weight(0) = float(n - 2) / float(n);
+      for (std::size_t i = 1; i <= 2 * n; ++i) s.weight(i) = 1.0f / float(n * n);
+    }
+  };
+  refine_vertices(m, out, rule, threads, added, even);
+  progress.update(from + 0.8 * (to - from), "subdividing: attributes");
+
+  // Corners: a midpoint corner per old inner half-edge h (between h's and prev(h)'s corners),
+  // then a centroid corner per face point.
+  refine_corners(m, out, std::size_t(H) + FP, hmap, threads, [&](const std::vector<Target>& all, unsigned t) {
+    parallel_for(H, t, [&](std::size_t lo, std::size_t hi) {
+      for (Index h = Index(lo); h < hi; ++h) {
+        if (m.is_boundary(Halfedge(h))) continue;
+        const Index sources[2] = {m.prev(Halfedge(h)).idx(), h};
+        const float half[2] = {0.5f, 0.5f};
+        for (const Target& x : all) blend(x, H + h, sources, half);
+      }
+    });
+    parallel_for(FP, t, [&](std::size_t lo, std::size_t hi) {
+      std::vector<Index> sources;
+      std::vector<float> w;
+      for (Index k = Index(lo); k < hi; ++k) {
+        sources.clear();
+        for (Halfedge x : m.halfedges(Face(plan.face_of_point[k]))) sources.push_back(x.idx());
+        w.assign(sources.size(), 1.0f / float(sources.size()));
+        for (const Target& x : all) blend(x, centroid_slot + k, sources, w);
+      }
+    });
+  });
+  if (edge_props)
+    copy_parents(m.edge_properties(), out.edge_properties(), E, emap, E2);
+  else
+    out.edge_properties().resize(E2);
+  if (face_props)
+    copy_parents(m.face_properties(), out.face_properties(), F, fmap, F2);
+  else
+    out.face_properties().resize(F2);
+  return out;
+}
+
+// ---- √3: a vertex per face, then every interior old edge flipped -----------------------------
+
+Mesh sqrt3_step(const Mesh& m, unsigned threads, Progress& progress, double from, double to) {
+  const Index V = Index(m.vertices_size()), E = Index(m.edges_size()), F = Index(m.faces_size());
+  const Index H = 2 * E;
+  check_index_range(std::size_t(V) + F, std::size_t(E) + 3 * std::size_t(F), 3 * std::size_t(F));
+  const Index V2 = V + F, E2 = E + 3 * F, F2 = 3 * F;
+
+  // Corner number of every inner half-edge in its triangle (halfedge(f) is corner 0).
+  std::vector<std::uint8_t> corner(H, 0);
+  parallel_for(F, threads, [&](std::size_t lo, std::size_t hi) {
+    for (Index f = Index(lo); f < hi; ++f) {
+      Halfedge h = m.halfedge(Face(f));
+      for (std::uint8_t i = 0; i < 3; ++i, h = m.next(h)) corner[h.idx()] = i;
+    }
+  });
+
+  Mesh out;
+  out.resize(V2, E2, F2);
+  const bool corner_props = m.halfedge_properties().count() > 0;
+  const bool edge_props = m.edge_properties().count() > 0;
+  const bool face_props = m.face_properties().count() > 0;
+  std::vector<Index> hmap(corner_props ? std::size_t(2) * E2 : 0), emap(edge_props ? E2 : 0), fmap(face_props ? F2 : 0);
+
+  // Spoke (f, i) joins face point P_f and corner c_i; side 0 runs P_f -> c_i. The old inner
+  // half-edge h = h_i of f (pointing to c_i) keeps its index: when its edge is interior it
+  // becomes P_f -> P_g (g the face across), and triangle 3f + i is (c_i, P_f, P_g); on the
+  // boundary it stays, and triangle 3f + i is (c_{i-1}, c_i, P_f).
+  auto spoke = [&](Index f, Index i, unsigned side) { return Halfedge(2 * (E + 3 * f + i % 3) + side); };
+  parallel_for(F, threads, [&](std::size_t lo, std::size_t hi) {
+    for (Index f = Index(lo); f < hi; ++f) {
+      const Vertex pf(V + f);
+      Halfedge h = m.halfedge(Face(f));
+      for (Index i = 0; i < 3; ++i, h = m.next(h)) {
+        const Face t(3 * f + i);
+        out.set_vertex(spoke(f, i, 0), m.to_vertex(h));
+        out.set_vertex(spoke(f, i, 1), pf);
+        const Halfedge g = Mesh::opposite(h);
+        const Halfedge a = spoke(f, i, 1);
+        Halfedge b, c;
+        if (m.is_boundary(g)) {
+          out.set_vertex(h, m.to_vertex(h));
+          b = spoke(f, i + 2, 0);  // P_f -> c_{i-1}
+          c = h;
+          out.set_halfedge(t, h);
+          if (corner_props) {
+            hmap[h.idx()] = h.idx();
+            hmap[b.idx()] = m.prev(h).idx();
+          }
+        } else {
+          const Index fg = m.face(g).idx();
+          out.set_vertex(h, Vertex(V + fg));
+          b = h;
+          c = spoke(fg, corner[m.prev(g).idx()], 0);  // P_g -> c_i
+          out.set_halfedge(t, c);
+          if (corner_props) {
+            hmap[h.idx()] = H + fg;  // the centroid corner of g
+            hmap[c.idx()] = h.idx();
+          }
+        }
+        // a: c_i -> P_f, then b, then c back to a's origin.
+        out.set_next(a, b);
+        out.set_next(b, c);
+        out.set_next(c, a);
+        out.set_face(a, t);
+        out.set_face(b, t);
+        out.set_face(c, t);
+        if (corner_props) hmap[a.idx()] = H + f;
+        if (face_props) fmap[t.idx()] = f;
+        if (edge_props) emap[E + 3 * f + i] = E;
+      }
+      out.set_halfedge(pf, spoke(f, 0, 0));
+    }
+  });
+  progress.update(from + 0.3 * (to - from), "subdividing: connectivity");
+  parallel_for(E, threads, [&](std::size_t lo, std::size_t hi) {
+    for (Index e = Index(lo); e < hi; ++e) {
+      for (unsigned side = 0; side < 2; ++side) {
+        const Halfedge h = Mesh::halfedge(Edge(e), side);
+        if (!m.is_boundary(h)) continue;
+        out.set_vertex(h, m.to_vertex(h));
+        out.set_next(h, m.next(h));
+        if (corner_props) hmap[h.idx()] = h.idx();
+      }
+      if (edge_props) emap[e] = e;
+    }
+  });
+  // Old vertices: boundary ones keep their boundary half-edge; interior ones leave along a
+  // spoke, since their old edges were flipped away.
+  for (Index v = 0; v < V; ++v) {
+    const Halfedge h = m.halfedge(Vertex(v));
+    if (!h.is_valid() || m.is_boundary(h)) {
+      out.set_halfedge(Vertex(v), h);
+    } else {
+      const Halfedge in = m.prev(h);  // points to v inside face(h)
+      out.set_halfedge(Vertex(v), spoke(m.face(h).idx(), corner[in.idx()], 1));
+    }
+  }
+
+  VertexRule rule;
+  rule.V = V;
+  rule.added = F;
+  rule.phases = {{0, F}};
+  auto added = [&](Index f, Stencil& s) {
+    for (Vertex c : m.vertices(Face(f))) s.add(c.idx(), 1.0f / 3.0f);
+  };
+  auto even = [&](Vertex v, Stencil& s) {
+    if (m.is_boundary(v)) {  // boundary curves are kept (see subdivide.h)
+      s.add(v.idx(), 1.0f);
+      return;
+    }
+    const std::size_t n = m.valence(v);
+    const double alpha = (4.0 - 2.0 * std::cos(2.0 * std::numbers::pi / double(n))) / 9.0;
+    s.add(v.idx(), float(1.0 - alpha));
+    for (Vertex w : m.vertices(v)) s.add(w.idx(), float(alpha / double(n)));
+  };
+  refine_vertices(m, out, rule, threads, added, even);
+  progress.update(from + 0.8 * (to - from), "subdividing: attributes");
+
+  refine_corners(m, out, F, hmap, threads, [&](const std::vector<Target>& all, unsigned t) {
+    parallel_for(F, t, [&](std::size_t lo, std::size_t hi) {
+      const float third[3] = {1.0f / 3, 1.0f / 3, 1.0f / 3};
+      for (Index f = Index(lo); f < hi; ++f) {
+        const Halfedge h = m.halfedge(Face(f));
+        const Index sources[3] = {h.idx(), m.next(h).idx(), m.prev(h).idx()};
+        for (const Target& x : all) blend(x, H + f, sources, third);
+      }
+    });
+  });
+  if (edge_props)
+    copy_parents(m.edge_properties(), out.edge_properties(), E, emap, E2);
+  else
+    out.edge_properties().resize(E2);
+  if (face_props)
+    copy_parents(m.face_properties(), out.face_properties(), F, fmap, F2);
+  else
+    out.face_properties().resize(F2);
+  return out;
+}
+
+//! Faces by kind, in one pass: what the refusals and the size forecast need.
+struct FaceCensus {
+  std::size_t faces = 0, triangles = 0, corners = 0;
+};
+
+FaceCensus face_census(const Mesh& mesh) {
+  FaceCensus c;
+  for (Face f : mesh.faces()) {
+    const Index n = face_size(mesh, f);
+    ++c.faces;
+    c.triangles += n == 3;
+    c.corners += n;
+  }
+  return c;
+}
+
+std::size_t forecast_faces(const FaceCensus& c, const SubdivideOptions& options) {
+  if (options.iterations <= 0 || c.faces == 0) return c.faces;
+  // Doubles, so that absurd requests compare as huge instead of wrapping around.
+  double first = 0;
+  switch (options.scheme) {
+    case SubdivisionScheme::loop:
+      first = 4.0 * double(c.faces);
+      break;
+    case SubdivisionScheme::sqrt3:
+      first = 3.0 * double(c.faces);
+      break;
+    case SubdivisionScheme::catmull_clark:
+      first = double(c.corners);
+      break;
+    case SubdivisionScheme::midpoint:
+      first = 4.0 * double(c.triangles) + double(c.corners - 3 * c.triangles);
+      break;
+  }
+  const double factor = options.scheme == SubdivisionScheme::sqrt3 ? 3.0 : 4.0;
+  const double total = first * std::pow(factor, options.iterations - 1);
+  return total >= 1e18 ? std::size_t(1e18) : std::size_t(total);
+}
+
+}  // namespace
+
+SubdivisionScheme subdivision_scheme_from_name(const std::string& name) {
+  if (name == "loop") return SubdivisionScheme::loop;
+  if (name == "catmull_clark") return SubdivisionScheme::catmull_clark;
+  if (name == "sqrt3") return SubdivisionScheme::sqrt3;
+  if (name == "midpoint") return SubdivisionScheme::midpoint;
+  throw Error("subdivide: unknown scheme '" + name + "'; the schemes are loop, catmull_clark, sqrt3, midpoint");
+}
+
+const char* subdivision_scheme_name(SubdivisionScheme scheme) {
+  switch (scheme) {
+    case SubdivisionScheme::loop:
+      return "loop";
+    case SubdivisionScheme::catmull_clark:
+      return "catmull_clark";
+    case SubdivisionScheme::sqrt3:
+      return "sqrt3";
+    case SubdivisionScheme::midpoint:
+      return "midpoint";
+  }
+  return "unknown";
+}
+
+std::size_t subdivided_face_count(const Mesh& mesh, const SubdivideOptions& options) {
+  return forecast_faces(face_census(mesh), options);
+}
+
+SubdivideReport subdivide(Mesh& mesh, const SubdivideOptions& options, Progress& progress) {
+  const char* name = subdivision_scheme_name(options.scheme);
+  if (options.iterations < 1) throw Error("subdivide: iterations must be 1 or more");
+  const bool triangles_only = options.scheme == SubdivisionScheme::loop || options.scheme == SubdivisionScheme::sqrt3;
+  const FaceCensus census = face_census(mesh);
+  if (triangles_only) {
+    if (std::size_t polygons = census.faces - census.triangles)
+      throw Error(std::string("subdivide: the ") + name + " scheme works on triangle meshes, and " +
+                  std::to_string(polygons) + (polygons == 1 ? " face has" : " faces have") +
+                  " more than 3 corners; triangulate first, or use catmull_clark or midpoint");
+  }
+  const std::size_t predicted = forecast_faces(census, options);
+  if (predicted > options.max_faces)
+    throw Error("subdivide: " + std::to_string(options.iterations) + " iterations of " + name + " would make " +
+                std::to_string(predicted) + " faces, more than the limit of " + std::to_string(options.max_faces) +
+                "; use fewer iterations");
+
+  // The steps read `current` and write a fresh mesh; the input is replaced only at the end,
+  // so an error or a cancellation leaves it as it was.
+  Mesh compacted;
+  const Mesh* current = &mesh;
+  if (mesh.has_garbage()) {
+    compacted = mesh;
+    compacted.garbage_collect();
+    current = &compacted;
+  }
+  Mesh result;
+  for (int it = 0; it < options.iterations; ++it) {
+    const double from = double(it) / options.iterations, to = double(it + 1) / options.iterations;
+    progress.update(from, "subdividing: step " + std::to_string(it + 1) + " of " + std::to_string(options.iterations));
+    Mesh next = options.scheme == SubdivisionScheme::sqrt3
+                    ? sqrt3_step(*current, options.threads, progress, from, to)
+                    : split_step(*current, options.scheme, options.threads, progress, from, to);
+    result = std::move(next);
+    current = &result;
+  }
+  mesh = std::move(result);
+
+  SubdivideReport report;
+  report.vertices = mesh.n_vertices();
+  report.edges = mesh.n_edges();
+  report.faces = mesh.n_faces();
+  report.iterations = options.iterations;
+  return report;
+}
+
+Operation subdivide_operation() {
+  Operation op;
+  op.id = "subdivide";
+  op.title = "Subdivide";
+  op.category = "Remeshing";
+  op.help =
+      "Refines the surface: every step replaces each face by smaller ones and moves the vertices toward a smooth "
+      "limit surface. Schemes: loop (Loop 1987; triangles 1 to 4, smooth, for triangle meshes), catmull_clark "
+      "(Catmull & Clark 1978; every n-gon becomes n quads, for any polygon mesh), sqrt3 (Kobbelt 2000; a vertex "
+      "per triangle and the old edges flipped, the face count triples per step, for triangle meshes), midpoint "
+      "(no smoothing: triangles 1 to 4 at the edge midpoints, other polygons into quads around their centroid). "
+      "loop and sqrt3 refuse meshes with polygons: run Triangulate first. Boundaries: loop and catmull_clark "
+      "refine boundary curves with the cubic B-spline rule; sqrt3 keeps boundary edges and vertices fixed. "
+      "Attributes: vertex attributes are blended with the scheme's own weights, corner attributes (UVs) linearly "
+      "inside each old face so seams stay seams, face attributes (materials) are copied to the child faces. "
+      "Results above 200 million faces are refused before starting.";
+  op.params = {
+      ParamSpec::choice("scheme", "Scheme", {"loop", "catmull_clark", "sqrt3", "midpoint"}, 0,
+                        "loop and sqrt3 for triangle meshes, catmull_clark for any polygons (makes quads), "
+                        "midpoint to refine without smoothing"),
+      ParamSpec::integer("iterations", "Iterations", 1, 1, 6,
+                         "refinement steps; each multiplies the face count by 4 (sqrt3: 3)"),
+  };
+  op.run = [](Mesh& mesh, const ParamValues& values, Progress& progress) {
+    SubdivideOptions options;
+    options.scheme = subdivision_scheme_from_name(values.get_choice("scheme"));
+    options.iterations = int(values.get_int("iterations"));
+    const std::size_t faces_before = mesh.n_faces();
+    SubdivideReport r = subdivide(mesh, options, progress);
+    OperationReport report;
+    report.add("scheme", std::string(subdivision_scheme_name(options.scheme)));
+    report.add("iterations", std::int64_t(r.iterations));
+    report.add("faces_before", std::int64_t(faces_before));
+    report.add("vertices", std::int64_t(r.vertices));
+    report.add("edges", std::int64_t(r.edges));
+    report.add("faces", std::int64_t(r.faces));
+    return report;
+  };
+  return op;
+}
+
+}  // namespace hedge

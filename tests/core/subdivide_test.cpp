@@ -1,0 +1,553 @@
+// Tests of subdivide (subdivide.h): stencils checked against hand-computed positions, element
+// counts, boundaries, attributes, refusals, and the time of one Loop step on the dragon.
+#include "hedge/subdivide.h"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <ctime>
+#include <filesystem>
+#include <map>
+#include <set>
+#include <utility>
+#include <vector>
+
+#include "hedge/build.h"
+#include "hedge/error.h"
+#include "hedge/io.h"
+#include "hedge/report.h"
+#include "hedge/topology.h"
+#include "hedge/validate.h"
+
+namespace {
+
+using namespace hedge;
+
+// A manifold mesh made with the low-level setters (depends on nothing but Mesh itself).
+Mesh make_mesh(const std::vector<Point>& points, const std::vector<std::vector<Index>>& faces) {
+  Mesh mesh;
+  for (const Point& p : points) mesh.position(mesh.new_vertex()) = p;
+  std::map<std::pair<Index, Index>, Halfedge> between;
+  auto halfedge_from_to = [&](Index a, Index b) {
+    if (auto it = between.find({a, b}); it != between.end()) return it->second;
+    Halfedge h = mesh.new_edge(Vertex(a), Vertex(b));
+    between[{a, b}] = h;
+    between[{b, a}] = opposite(h);
+    return h;
+  };
+  for (const auto& corners : faces) {
+    const Face f = mesh.new_face();
+    const std::size_t n = corners.size();
+    std::vector<Halfedge> loop;
+    for (std::size_t i = 0; i < n; ++i) loop.push_back(halfedge_from_to(corners[(i + n - 1) % n], corners[i]));
+    for (std::size_t i = 0; i < n; ++i) {
+      mesh.set_face(loop[i], f);
+      mesh.set_next(loop[i], loop[(i + 1) % n]);
+      mesh.set_halfedge(Vertex(corners[i]), loop[(i + 1) % n]);
+    }
+    mesh.set_halfedge(f, loop[0]);
+  }
+  std::map<Index, Halfedge> boundary_out;
+  for (Index i = 0; i < mesh.halfedges_size(); ++i)
+    if (mesh.is_boundary(Halfedge(i))) boundary_out[mesh.from_vertex(Halfedge(i)).idx()] = Halfedge(i);
+  for (auto [v, h] : boundary_out) {
+    mesh.set_next(h, boundary_out.at(mesh.to_vertex(h).idx()));
+    mesh.set_halfedge(Vertex(v), h);
+  }
+  return mesh;
+}
+
+Mesh tetrahedron() {
+  return make_mesh({{{0, 0, 0}}, {{1, 0, 0}}, {{0, 1, 0}}, {{0, 0, 1}}}, {{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {0, 3, 2}});
+}
+
+Mesh unit_cube() {
+  return make_mesh(
+      {{{0, 0, 0}}, {{1, 0, 0}}, {{1, 1, 0}}, {{0, 1, 0}}, {{0, 0, 1}}, {{1, 0, 1}}, {{1, 1, 1}}, {{0, 1, 1}}},
+      {{0, 3, 2, 1}, {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}, {4, 5, 6, 7}});
+}
+
+// An n x n grid of unit squares split into triangles, in the plane z = 0 (open: one boundary loop).
+Mesh grid(int n, bool triangles = true) {
+  std::vector<Point> p;
+  std::vector<std::vector<Index>> f;
+  for (int y = 0; y <= n; ++y)
+    for (int x = 0; x <= n; ++x) p.push_back({{float(x), float(y), 0}});
+  auto id = [&](int x, int y) { return Index(y * (n + 1) + x); };
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n; ++x) {
+      if (triangles) {
+        f.push_back({id(x, y), id(x + 1, y), id(x + 1, y + 1)});
+        f.push_back({id(x, y), id(x + 1, y + 1), id(x, y + 1)});
+      } else {
+        f.push_back({id(x, y), id(x + 1, y), id(x + 1, y + 1), id(x, y + 1)});
+      }
+    }
+  return make_mesh(p, f);
+}
+
+void expect_point(const Point& got, const Vec3d& want, double tolerance = 1e-6) {
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(got[i], want[i], tolerance) << "component " << i;
+}
+
+Vec3d at(const Mesh& m, Index v) { return to_double(m.position(Vertex(v))); }
+
+void expect_valid(const Mesh& mesh) {
+  Validation v = validate(mesh);
+  EXPECT_TRUE(v.ok) << v.message;
+}
+
+SubdivideOptions scheme(SubdivisionScheme s, int iterations = 1) {
+  SubdivideOptions o;
+  o.scheme = s;
+  o.iterations = iterations;
+  return o;
+}
+
+TEST(Subdivide, LoopTetrahedronMatchesHandStencils) {
+  Mesh before = tetrahedron();
+  Mesh mesh = before;
+  SubdivideReport r = subdivide(mesh, scheme(SubdivisionScheme::loop));
+  expect_valid(mesh);
+  EXPECT_EQ(mesh.n_vertices(), 4u + 6u);  // V + E
+  EXPECT_EQ(mesh.n_faces(), 16u);         // 4F
+  EXPECT_EQ(mesh.n_edges(), 2u * 6 + 3 * 4);
+  EXPECT_EQ(r.faces, 16u);
+  EXPECT_TRUE(mesh.is_triangle_mesh());
+  // Even vertices, valence 3: beta = 3/16, the vertex keeps 1 - 3 beta = 7/16.
+  for (Index v = 0; v < 4; ++v) {
+    Vec3d want = at(before, v) * (7.0 / 16.0);
+    for (Index w = 0; w < 4; ++w)
+      if (w != v) want += at(before, w) * (3.0 / 16.0);
+    expect_point(mesh.position(Vertex(v)), want);
+  }
+  // Odd vertices: 3/8 for the edge's ends, 1/8 for the two opposite corners (the other two).
+  for (Edge e : before.edges()) {
+    Index a = before.vertex(e, 0).idx(), b = before.vertex(e, 1).idx();
+    Vec3d want = (at(before, a) + at(before, b)) * (3.0 / 8.0);
+    for (Index w = 0; w < 4; ++w)
+      if (w != a && w != b) want += at(before, w) * (1.0 / 8.0);
+    expect_point(mesh.position(Vertex(4 + e.idx())), want);
+  }
+  // Every new edge joins vertices that are close: no face got wired across the mesh.
+  for (Edge e : mesh.edges())
+    EXPECT_LT(distance(at(mesh, mesh.vertex(e, 0).idx()), at(mesh, mesh.vertex(e, 1).idx())), 0.8);
+}
+
+TEST(Subdivide, CatmullClarkCubeMatchesHandStencils) {
+  Mesh mesh = unit_cube();
+  subdivide(mesh, scheme(SubdivisionScheme::catmull_clark));
+  expect_valid(mesh);
+  EXPECT_EQ(mesh.n_vertices(), 8u + 12u + 6u);  // V + E + F
+  EXPECT_EQ(mesh.n_faces(), 24u);               // sum of face sizes
+  EXPECT_TRUE(mesh.is_quad_mesh());
+  // Old vertices, n = 3: Q = mean of the 3 face centres, R = mean of the 3 edge midpoints,
+  // (Q + 2R + 0 S) / 3. At the origin: Q = (1/3, 1/3, 1/3), R = (1/6, 1/6, 1/6) -> 2/9.
+  const Mesh cube = unit_cube();
+  for (Index v = 0; v < 8; ++v) {
+    const Point& p = cube.position(Vertex(v));
+    Vec3d want;
+    for (int i = 0; i < 3; ++i) want[i] = p[i] > 0.5f ? 7.0 / 9.0 : 2.0 / 9.0;
+    expect_point(mesh.position(Vertex(v)), want);
+  }
+  // Face points at the face centres (after the 20 vertex and edge points, in face order).
+  expect_point(mesh.position(Vertex(20)), {{0.5, 0.5, 0}});
+  expect_point(mesh.position(Vertex(25)), {{0.5, 0.5, 1}});
+  // Edge points: (a + b + F1 + F2) / 4; for edge (0,0,0)-(1,0,0): faces z = 0 and y = 0.
+  Edge e = cube.find_edge(Vertex(0), Vertex(1));
+  ASSERT_TRUE(e.is_valid());
+  expect_point(mesh.position(Vertex(8 + e.idx())), {{0.5, 0.125, 0.125}});
+  for (Edge x : cube.edges()) {
+    const Point& p = mesh.position(Vertex(8 + x.idx()));
+    int at_half = 0, inner = 0;
+    for (int i = 0; i < 3; ++i) {
+      at_half += std::abs(p[i] - 0.5f) < 1e-6f;
+      inner += std::abs(p[i] - 0.125f) < 1e-6f || std::abs(p[i] - 0.875f) < 1e-6f;
+    }
+    EXPECT_EQ(at_half, 1) << "edge " << x.idx();
+    EXPECT_EQ(inner, 2) << "edge " << x.idx();
+  }
+}
+
+TEST(Subdivide, CatmullClarkTwoStepsOnMixedPolygons) {
+  // A pyramid: a quad base and four triangles.
+  Mesh mesh = make_mesh({{{0, 0, 0}}, {{1, 0, 0}}, {{1, 1, 0}}, {{0, 1, 0}}, {{0.5f, 0.5f, 1}}},
+                        {{0, 3, 2, 1}, {0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}});
+  subdivide(mesh, scheme(SubdivisionScheme::catmull_clark, 2));
+  expect_valid(mesh);
+  EXPECT_EQ(mesh.n_faces(), 16u * 4);  // 4 + 4 * 3 quads, then x4
+  EXPECT_TRUE(mesh.is_quad_mesh());
+  EXPECT_EQ(topology_stats(mesh).euler_characteristic, 2);
+}
+
+TEST(Subdivide, CountsFollowTheFormulasOverIterations) {
+  for (auto s : {SubdivisionScheme::loop, SubdivisionScheme::sqrt3, SubdivisionScheme::midpoint,
+                 SubdivisionScheme::catmull_clark}) {
+    Mesh mesh = tetrahedron();
+    std::size_t V = 4, E = 6, F = 4;
+    for (int it = 1; it <= 3; ++it) {
+      subdivide(mesh, scheme(s));
+      expect_valid(mesh);
+      switch (s) {
+        case SubdivisionScheme::loop:
+        case SubdivisionScheme::midpoint:
+          V += E, E = 2 * E + 3 * F, F *= 4;
+          break;
+        case SubdivisionScheme::sqrt3:
+          V += F, E += 3 * F, F *= 3;
+          break;
+        case SubdivisionScheme::catmull_clark: {
+          std::size_t corners = 2 * E;  // closed mesh: every half-edge is a corner
+          V += E + F, E = 2 * E + corners, F = corners;
+          break;
+        }
+      }
+      EXPECT_EQ(mesh.n_vertices(), V) << subdivision_scheme_name(s) << " step " << it;
+      EXPECT_EQ(mesh.n_edges(), E) << subdivision_scheme_name(s) << " step " << it;
+      EXPECT_EQ(mesh.n_faces(), F) << subdivision_scheme_name(s) << " step " << it;
+      EXPECT_EQ(topology_stats(mesh).genus, 0);
+      EXPECT_EQ(topology_stats(mesh).boundary_loops, 0u);
+    }
+    SubdivideOptions o = scheme(s, 3);
+    EXPECT_EQ(subdivided_face_count(tetrahedron(), o), F) << subdivision_scheme_name(s);
+  }
+}
+
+TEST(Subdivide, Sqrt3StencilsOnTetrahedron) {
+  Mesh before = tetrahedron();
+  Mesh mesh = before;
+  subdivide(mesh, scheme(SubdivisionScheme::sqrt3));
+  expect_valid(mesh);
+  // Face points at the centroids.
+  for (Face f : before.faces()) {
+    Vec3d c{};
+    for (Vertex v : before.vertices(f)) c += at(before, v.idx()) / 3.0;
+    expect_point(mesh.position(Vertex(4 + f.idx())), c);
+  }
+  // Old vertices: (1 - a) v + a/n sum, a = (4 - 2 cos(2 pi / n)) / 9 = 5/9 for n = 3.
+  for (Index v = 0; v < 4; ++v) {
+    Vec3d want = at(before, v) * (4.0 / 9.0);
+    for (Index w = 0; w < 4; ++w)
+      if (w != v) want += at(before, w) * (5.0 / 27.0);
+    expect_point(mesh.position(Vertex(v)), want);
+  }
+  // Every old edge was flipped: no two old vertices are joined any more; each old vertex has
+  // valence 3 (its spokes), each face point valence 6 after the flip (3 spokes + 3 flipped edges).
+  for (Index a = 0; a < 4; ++a) {
+    for (Index b = a + 1; b < 4; ++b) EXPECT_FALSE(mesh.find_edge(Vertex(a), Vertex(b)).is_valid());
+    EXPECT_EQ(mesh.valence(Vertex(a)), 3u);
+  }
+  for (Index f = 0; f < 4; ++f) EXPECT_EQ(mesh.valence(Vertex(4 + f)), 6u);
+}
+
+TEST(Subdivide, LoopBoundaryFollowsTheCurveRules) {
+  Mesh before = grid(3);
+  Mesh mesh = before;
+  subdivide(mesh, scheme(SubdivisionScheme::loop));
+  expect_valid(mesh);
+  EXPECT_EQ(topology_stats(mesh).boundary_loops, 1u);
+  EXPECT_EQ(topology_stats(mesh).boundary_edges, 2 * topology_stats(before).boundary_edges);
+  for (Vertex v : mesh.vertices()) EXPECT_EQ(mesh.position(v)[2], 0.0f);  // planar stays planar
+  // Boundary vertex (1, 0): 3/4 itself + 1/8 (0,0) + 1/8 (2,0) = (1, 0); the corner (0, 0):
+  // 3/4 (0,0) + 1/8 (1,0) + 1/8 (0,1).
+  expect_point(mesh.position(Vertex(1)), {{1, 0, 0}});
+  expect_point(mesh.position(Vertex(0)), {{0.125, 0.125, 0}});
+  // A boundary edge point is the midpoint.
+  Edge b = before.find_edge(Vertex(0), Vertex(1));
+  expect_point(mesh.position(Vertex(16 + b.idx())), {{0.5, 0, 0}});
+  // Interior vertex (1, 1), valence 6, regular: beta = 1/16, weights 10/16 and 6 x 1/16.
+  Vec3d want = at(before, 5) * (10.0 / 16.0);
+  for (Vertex w : before.vertices(Vertex(5))) want += at(before, w.idx()) / 16.0;
+  expect_point(mesh.position(Vertex(5)), want);
+}
+
+TEST(Subdivide, CatmullClarkBoundaryRules) {
+  Mesh before = grid(2, false);  // 2 x 2 quads
+  Mesh mesh = before;
+  subdivide(mesh, scheme(SubdivisionScheme::catmull_clark));
+  expect_valid(mesh);
+  EXPECT_EQ(mesh.n_faces(), 16u);
+  // Corner (0,0): 3/4 + 1/8 (1,0) + 1/8 (0,1). Centre (1,1), n = 4: stays (regular, symmetric).
+  expect_point(mesh.position(Vertex(0)), {{0.125, 0.125, 0}});
+  expect_point(mesh.position(Vertex(4)), {{1, 1, 0}});
+  Edge b = before.find_edge(Vertex(0), Vertex(1));
+  expect_point(mesh.position(Vertex(9 + b.idx())), {{0.5, 0, 0}});
+  // Interior edge (1,0)-(1,1): (a + b + F1 + F2) / 4 = ((1,0) + (1,1) + (.5,.5) + (1.5,.5)) / 4.
+  Edge i = before.find_edge(Vertex(1), Vertex(4));
+  expect_point(mesh.position(Vertex(9 + i.idx())), {{1, 0.5, 0}});
+}
+
+TEST(Subdivide, Sqrt3KeepsBoundaries) {
+  Mesh before = grid(2);
+  Mesh mesh = before;
+  subdivide(mesh, scheme(SubdivisionScheme::sqrt3, 2));
+  expect_valid(mesh);
+  EXPECT_EQ(mesh.n_faces(), before.n_faces() * 9);
+  EXPECT_EQ(topology_stats(mesh).boundary_edges, topology_stats(before).boundary_edges);
+  for (Vertex v : before.vertices())
+    if (before.is_boundary(v)) expect_point(mesh.position(v), at(before, v.idx()));
+}
+
+TEST(Subdivide, MidpointIsLinear) {
+  // A cube whose top is two triangles: quads split around centroids, triangles 1 -> 4.
+  Mesh before = make_mesh(
+      {{{0, 0, 0}}, {{1, 0, 0}}, {{1, 1, 0}}, {{0, 1, 0}}, {{0, 0, 1}}, {{1, 0, 1}}, {{1, 1, 1}}, {{0, 1, 1}}},
+      {{0, 3, 2, 1}, {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}, {4, 5, 6}, {4, 6, 7}});
+  Mesh mesh = before;
+  subdivide(mesh, scheme(SubdivisionScheme::midpoint));
+  expect_valid(mesh);
+  const std::size_t V = 8, E = before.n_edges();
+  EXPECT_EQ(mesh.n_vertices(), V + E + 5);
+  EXPECT_EQ(mesh.n_faces(), 5u * 4 + 2 * 4);
+  for (Index v = 0; v < V; ++v) expect_point(mesh.position(Vertex(v)), at(before, v));
+  for (Edge e : before.edges())
+    expect_point(mesh.position(Vertex(V + e.idx())),
+                 (at(before, before.vertex(e, 0).idx()) + at(before, before.vertex(e, 1).idx())) * 0.5);
+  expect_point(mesh.position(Vertex(V + E)), {{0.5, 0.5, 0}});
+  // Area is kept exactly by a linear refinement of planar faces.
+  EXPECT_NEAR(mesh_statistics(mesh).area, 6.0, 1e-5);
+}
+
+// A vertex channel equal to the positions must follow the positions (same stencils), and the
+// mesh's own "hedge:source" must stay on the old vertices only.
+TEST(Subdivide, VertexAttributesFollowTheStencils) {
+  for (auto s : {SubdivisionScheme::loop, SubdivisionScheme::sqrt3, SubdivisionScheme::catmull_clark}) {
+    Mesh mesh = grid(3);
+    mesh.position(Vertex(5))[2] = 0.7f;  // not flat, so the stencils matter
+    ChannelArray* color = mesh.vertex_properties().add_channel("color", ScalarType::f32, 3);
+    ChannelArray* quality = mesh.vertex_properties().add_channel("quality", ScalarType::f64, 1);
+    auto source = mesh.add_vertex_property<std::uint32_t>("hedge:source", kInvalidIndex);
+    for (Vertex v : mesh.vertices()) {
+      std::memcpy(color->element(v.idx()), &mesh.position(v), sizeof(Point));
+      const double q = mesh.position(v)[0];
+      std::memcpy(quality->element(v.idx()), &q, sizeof q);
+      source[v] = 100 + v.idx();
+    }
+    const std::size_t V = mesh.n_vertices();
+    subdivide(mesh, scheme(s));
+    expect_valid(mesh);
+    color = mesh.vertex_properties().get_channel("color");
+    quality = mesh.vertex_properties().get_channel("quality");
+    source = mesh.get_vertex_property<std::uint32_t>("hedge:source");
+    ASSERT_TRUE(color && quality && source);
+    for (Vertex v : mesh.vertices()) {
+      Point c;
+      std::memcpy(&c, color->element(v.idx()), sizeof c);
+      expect_point(c, to_double(mesh.position(v)), 1e-5);
+      double q;
+      std::memcpy(&q, quality->element(v.idx()), sizeof q);
+      EXPECT_NEAR(q, mesh.position(v)[0], 1e-5);
+      EXPECT_EQ(source[v], v.idx() < V ? 100 + v.idx() : kInvalidIndex) << subdivision_scheme_name(s);
+    }
+  }
+}
+
+// Corner UVs: each face gets its own chart (a seam everywhere) uv = (x + 10 f, y); face
+// channel "material" = f. After a linear refinement every child corner must read its parent's
+// chart at its own position, so seams stay seams.
+TEST(Subdivide, CornerAndFaceAttributesStayInTheirFace) {
+  for (auto s : {SubdivisionScheme::midpoint, SubdivisionScheme::loop, SubdivisionScheme::catmull_clark}) {
+    Mesh mesh = s == SubdivisionScheme::catmull_clark ? grid(2, false) : grid(2);
+    ChannelArray* uv = mesh.halfedge_properties().add_channel("uv", ScalarType::f32, 2);
+    ChannelArray* material = mesh.face_properties().add_channel("material", ScalarType::i32, 1);
+    for (Face f : mesh.faces()) {
+      const std::int32_t id = std::int32_t(f.idx());
+      std::memcpy(material->element(f.idx()), &id, sizeof id);
+      for (Halfedge h : mesh.halfedges(f)) {
+        const Point& p = mesh.position(mesh.to_vertex(h));
+        const float value[2] = {p[0] + 10.0f * float(f.idx()), p[1]};
+        std::memcpy(uv->element(h.idx()), value, sizeof value);
+      }
+    }
+    const std::size_t F = mesh.n_faces();
+    const Mesh before = mesh;
+    subdivide(mesh, scheme(s));
+    expect_valid(mesh);
+    uv = mesh.halfedge_properties().get_channel("uv");
+    material = mesh.face_properties().get_channel("material");
+    ASSERT_TRUE(uv && material);
+    std::vector<int> children(F, 0);
+    for (Face f : mesh.faces()) {
+      std::int32_t parent;
+      std::memcpy(&parent, material->element(f.idx()), sizeof parent);
+      ASSERT_GE(parent, 0);
+      ASSERT_LT(std::size_t(parent), F);
+      ++children[std::size_t(parent)];
+      for (Halfedge h : mesh.halfedges(f)) {
+        float value[2];
+        std::memcpy(value, uv->element(h.idx()), sizeof value);
+        // The corner's chart is its parent's; positions are linear only for midpoint, so
+        // Loop and Catmull-Clark are checked for the chart (the offset) alone.
+        EXPECT_NEAR(std::floor((value[0] + 1.0f) / 10.0f), parent, 0.0) << subdivision_scheme_name(s);
+        if (s == SubdivisionScheme::midpoint) {
+          const Point& p = mesh.position(mesh.to_vertex(h));
+          EXPECT_NEAR(value[0], p[0] + 10.0f * float(parent), 1e-5f);
+          EXPECT_NEAR(value[1], p[1], 1e-5f);
+        }
+      }
+    }
+    for (int c : children) EXPECT_EQ(c, 4);
+    // Boundary half-edges hold zeros.
+    for (Halfedge h : mesh.halfedges())
+      if (mesh.is_boundary(h)) {
+        float value[2];
+        std::memcpy(value, uv->element(h.idx()), sizeof value);
+        EXPECT_EQ(value[0], 0.0f);
+        EXPECT_EQ(value[1], 0.0f);
+      }
+    (void)before;
+  }
+}
+
+TEST(Subdivide, Sqrt3CarriesCornersAndFaces) {
+  Mesh mesh = grid(2);
+  ChannelArray* uv = mesh.halfedge_properties().add_channel("uv", ScalarType::f32, 2);
+  for (Face f : mesh.faces())
+    for (Halfedge h : mesh.halfedges(f)) {
+      const Point& p = mesh.position(mesh.to_vertex(h));
+      const float value[2] = {p[0], p[1]};  // one continuous chart: uv = xy
+      std::memcpy(uv->element(h.idx()), value, sizeof value);
+    }
+  auto flipped = mesh.add_face_property<bool>("hedge:flipped", false);
+  flipped[Face(3)] = true;
+  subdivide(mesh, scheme(SubdivisionScheme::sqrt3));
+  expect_valid(mesh);
+  uv = mesh.halfedge_properties().get_channel("uv");
+  // The grid is flat and the boundary is kept, so after one step positions are still the
+  // affine image of the chart only at corners whose uv came from their own position: check
+  // face points (centroids) and old corners.
+  std::size_t checked = 0;
+  for (Face f : mesh.faces())
+    for (Halfedge h : mesh.halfedges(f)) {
+      float value[2];
+      std::memcpy(value, uv->element(h.idx()), sizeof value);
+      Vertex v = mesh.to_vertex(h);
+      if (v.idx() >= 9 || mesh.is_boundary(v)) {  // face points and fixed boundary vertices
+        EXPECT_NEAR(value[0], mesh.position(v)[0], 1e-5f);
+        EXPECT_NEAR(value[1], mesh.position(v)[1], 1e-5f);
+        ++checked;
+      }
+    }
+  EXPECT_GT(checked, 0u);
+  flipped = mesh.get_face_property<bool>("hedge:flipped");
+  std::size_t n_flipped = 0;
+  for (Face f : mesh.faces()) n_flipped += flipped[f];
+  EXPECT_EQ(n_flipped, 3u);  // the three children of face 3
+}
+
+TEST(Subdivide, RefusesPolygonsForTriangleSchemesAndLeavesTheMesh) {
+  for (auto s : {SubdivisionScheme::loop, SubdivisionScheme::sqrt3}) {
+    Mesh mesh = unit_cube();
+    try {
+      subdivide(mesh, scheme(s));
+      ADD_FAILURE() << "no error";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("triangulate"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(mesh.n_faces(), 6u);
+    EXPECT_EQ(mesh.n_vertices(), 8u);
+  }
+}
+
+TEST(Subdivide, RefusesHugeResultsBeforeStarting) {
+  Mesh mesh = tetrahedron();
+  SubdivideOptions o = scheme(SubdivisionScheme::loop, 6);
+  o.max_faces = 1000;  // 4 * 4^6 = 16384
+  EXPECT_THROW(subdivide(mesh, o), Error);
+  EXPECT_EQ(mesh.n_faces(), 4u);
+  // The catalogue's range stops at 6 iterations and the 200M limit applies by default.
+  const Operation& op = find_operation("subdivide");
+  EXPECT_THROW(resolve_params(op, std::map<std::string, std::string>{{"iterations", "7"}}), Error);
+  EXPECT_GT(subdivided_face_count(mesh, scheme(SubdivisionScheme::loop, 6)), 0u);
+}
+
+TEST(Subdivide, CancellingLeavesTheMeshUntouched) {
+  Mesh mesh = tetrahedron();
+  Progress cancel([](double fraction, const std::string&) { return fraction < 0.5; });
+  EXPECT_THROW(subdivide(mesh, scheme(SubdivisionScheme::loop, 3), cancel), Cancelled);
+  EXPECT_EQ(mesh.n_faces(), 4u);
+  expect_point(mesh.position(Vertex(1)), {{1, 0, 0}});
+}
+
+TEST(Subdivide, SkipsDeletedElementsAndKeepsIsolatedVertices) {
+  Mesh mesh = grid(2);
+  mesh.delete_face(Face(0));
+  const Vertex lone = mesh.new_vertex();
+  mesh.position(lone) = Point{{5, 5, 5}};
+  subdivide(mesh, scheme(SubdivisionScheme::loop));
+  expect_valid(mesh);
+  EXPECT_EQ(mesh.n_faces(), 7u * 4);
+  EXPECT_FALSE(mesh.has_garbage());
+  std::size_t isolated = 0;
+  for (Vertex v : mesh.vertices()) isolated += mesh.is_isolated(v);
+  EXPECT_EQ(isolated, 1u);
+}
+
+TEST(Subdivide, CatalogueEntry) {
+  const Operation& op = find_operation("subdivide");
+  EXPECT_EQ(op.category, "Remeshing");
+  ASSERT_NE(op.find_param("scheme"), nullptr);
+  EXPECT_EQ(op.find_param("scheme")->choices, (std::vector<std::string>{"loop", "catmull_clark", "sqrt3", "midpoint"}));
+  EXPECT_EQ(op.find_param("iterations")->default_value, 1);
+  Mesh mesh = unit_cube();
+  OperationReport r = op.run(
+      mesh, resolve_params(op, std::map<std::string, std::string>{{"scheme", "catmull_clark"}, {"iterations", "2"}}),
+      Progress::none());
+  expect_valid(mesh);
+  EXPECT_EQ(mesh.n_faces(), 96u);
+  ASSERT_NE(r.find("faces"), nullptr);
+  EXPECT_EQ(std::get<std::int64_t>(*r.find("faces")), 96);
+}
+
+Mesh load(const std::string& name) {
+  const std::string path = std::string(HEDGE_MESH_DIR) + "/" + name;
+  if (!std::filesystem::exists(path)) return Mesh();
+  return build(read_mesh(path)).mesh;
+}
+
+TEST(Subdivide, BunnyAllSchemes) {
+  Mesh bunny = load("bunny.off");
+  if (bunny.is_empty()) GTEST_SKIP() << "bunny.off not found";
+  const double area = mesh_statistics(bunny).area;
+  for (auto s : {SubdivisionScheme::loop, SubdivisionScheme::sqrt3, SubdivisionScheme::catmull_clark,
+                 SubdivisionScheme::midpoint}) {
+    Mesh mesh = bunny;
+    subdivide(mesh, scheme(s, 2));
+    expect_valid(mesh);
+    EXPECT_EQ(mesh.n_faces(), subdivided_face_count(bunny, scheme(s, 2)));
+    // Smoothing schemes shrink a little; nothing should blow up.
+    const double ratio = mesh_statistics(mesh).area / area;
+    EXPECT_GT(ratio, 0.8) << subdivision_scheme_name(s);
+    EXPECT_LT(ratio, 1.05) << subdivision_scheme_name(s);
+    // Soup round trip keeps the same face count.
+    EXPECT_EQ(extract(mesh).n_faces(), mesh.n_faces());
+  }
+}
+
+TEST(Subdivide, DragonLoopTiming) {
+  const std::string path = std::string(HEDGE_MESH_DIR) + "/dragon.ply";
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "dragon.ply not found";
+  Mesh dragon = build(read_mesh(path)).mesh;
+  ASSERT_GT(dragon.n_faces(), 800000u);
+  // Wall time on two threads, and the process CPU time (the honest figure when other jobs
+  // share the cores).
+  double best = 1e9, best_cpu = 1e9;
+  Mesh mesh;
+  for (int run = 0; run < 3; ++run) {
+    mesh = dragon;
+    const auto start = std::chrono::steady_clock::now();
+    const std::clock_t cpu_start = std::clock();
+    subdivide(mesh, scheme(SubdivisionScheme::loop));
+    best_cpu = std::min(best_cpu, double(std::clock() - cpu_start) / CLOCKS_PER_SEC);
+    best = std::min(best, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  }
+  std::printf("[ figures  ] Loop subdivision of the dragon (%zu -> %zu faces): %.3f s wall, %.3f s CPU (best of 3)\n",
+              dragon.n_faces(), mesh.n_faces(), best, best_cpu);
+  EXPECT_EQ(mesh.n_faces(), 4 * dragon.n_faces());
+  expect_valid(mesh);
+}
+
+}  // namespace
