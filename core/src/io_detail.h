@@ -1,0 +1,254 @@
+// Pieces shared by the file readers and writers (core/src/io_*.cpp only): error messages
+// that name the place, a text scanner that counts lines, exact number parsing and printing.
+#pragma once
+
+#include <array>
+#include <bit>
+#include <charconv>
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <string>
+#include <string_view>
+#include <system_error>
+#include <type_traits>
+
+#include "hedge/error.h"
+#include "hedge/soup.h"
+
+namespace hedge::io_detail {
+
+[[noreturn]] void fail_line(const std::string& name, std::size_t line, const std::string& what);
+[[noreturn]] void fail_byte(const std::string& name, std::size_t offset, const std::string& what);
+
+//! A token for an error message: 'abc' (shortened when long), or "end of line"/"end of file".
+std::string quote(std::string_view token, bool at_end_of_file = false);
+
+//! Runs soup.check() and puts the file name in front of its message: readers leave
+//! topology alone, but a bad index or a NaN should still be reported against the file.
+void check_soup(const Soup& soup, const std::string& name);
+
+//! "1 face", "2 faces"; irregular words give their plural: plural(n, "vertex", "vertices").
+inline std::string plural(std::uint64_t n, const char* word, const char* words = nullptr) {
+  if (n == 1) return "1 " + std::string(word);
+  return std::to_string(n) + " " + (words ? std::string(words) : std::string(word) + "s");
+}
+
+//! Parses the whole token as a T (integer or floating point). Accepts a leading '+', which
+//! std::from_chars does not. Floating-point values too small or too large for T become
+//! 0 or infinity, as strtod would give.
+template <class T>
+bool parse_number(std::string_view token, T& out);
+
+// Out of line: the rare path of values beyond the range of float or double.
+bool parse_out_of_range(std::string_view token, float& out);
+bool parse_out_of_range(std::string_view token, double& out);
+
+template <class T>
+inline bool parse_number(std::string_view token, T& out) {
+  const char* first = token.data();
+  const char* last = first + token.size();
+  if (first != last && *first == '+') {
+    ++first;
+    if (first != last && (*first == '-' || *first == '+')) return false;
+  }
+  if (first == last) return false;
+  if constexpr (std::is_floating_point_v<T>) {
+    auto [ptr, ec] = std::from_chars(first, last, out, std::chars_format::general);
+    if (ec == std::errc::result_out_of_range && ptr == last)
+      return parse_out_of_range({first, std::size_t(last - first)}, out);
+    return ec == std::errc() && ptr == last;
+  } else {
+    auto [ptr, ec] = std::from_chars(first, last, out);
+    return ec == std::errc() && ptr == last;
+  }
+}
+
+//! Appends the shortest text that reads back as exactly `value`.
+template <class T>
+inline void append_number(std::string& out, T value) {
+  char buffer[64];
+  auto result = std::to_chars(buffer, buffer + sizeof buffer, value);
+  out.append(buffer, result.ptr);
+}
+
+//! Little- or big-endian loads and stores of numbers, whatever the host's order.
+template <class T>
+inline T load(const unsigned char* p, bool big_endian) {
+  using U = std::conditional_t<sizeof(T) == 1, std::uint8_t,
+                               std::conditional_t<sizeof(T) == 2, std::uint16_t,
+                                                  std::conditional_t<sizeof(T) == 4, std::uint32_t, std::uint64_t>>>;
+  U bits;
+  std::memcpy(&bits, p, sizeof bits);
+  if (big_endian != (std::endian::native == std::endian::big)) {
+    if constexpr (sizeof(U) == 2) bits = static_cast<U>(__builtin_bswap16(bits));
+    if constexpr (sizeof(U) == 4) bits = __builtin_bswap32(bits);
+    if constexpr (sizeof(U) == 8) bits = __builtin_bswap64(bits);
+  }
+  return std::bit_cast<T>(bits);
+}
+
+template <class T>
+inline void append_le(std::string& out, T value) {
+  auto bits = std::bit_cast<std::array<char, sizeof(T)>>(value);
+  if constexpr (std::endian::native == std::endian::big)
+    for (std::size_t i = sizeof(T); i-- > 0;) out.push_back(bits[i]);
+  else
+    out.append(bits.data(), sizeof(T));
+}
+
+//! Whitespace-separated tokens over a text, counting lines for error messages.
+//! Optionally a comment character (a token starting with it runs to the end of the line)
+//! and backslash line continuation (OBJ).
+class TextScanner {
+ public:
+  TextScanner(std::string_view text, const std::string& name, char comment = 0, bool continuation = false)
+      : begin_(text.data()),
+        p_(text.data()),
+        end_(text.data() + text.size()),
+        name_(name),
+        comment_(comment),
+        continuation_(continuation) {}
+
+  //! The next token on the current line; empty at the end of the line or file.
+  std::string_view line_token() {
+    skip_space_in_line();
+    const char* start = p_;
+    if (continuation_) {
+      while (p_ < end_ && !is_space(*p_) && !(*p_ == '\\' && is_continuation(p_))) ++p_;
+    } else {
+      while (p_ < end_ && !is_space(*p_)) ++p_;
+    }
+    return {start, static_cast<std::size_t>(p_ - start)};
+  }
+
+  //! The next token, on this line or a later one; empty at the end of the file.
+  std::string_view token() {
+    skip_space();
+    return line_token();
+  }
+
+  //! Skips spaces, comments and line ends; the line count follows.
+  void skip_space() {
+    for (;;) {
+      skip_space_in_line();
+      if (p_ < end_ && *p_ == '\n') {
+        ++p_;
+        ++line_;
+        continue;
+      }
+      return;
+    }
+  }
+
+  //! True when nothing but spaces or a comment is left on the current line.
+  bool at_line_end() {
+    skip_space_in_line();
+    return p_ == end_ || *p_ == '\n';
+  }
+
+  //! Moves to the start of the next line (or the end of the file).
+  void next_line() {
+    const void* nl = std::memchr(p_, '\n', static_cast<std::size_t>(end_ - p_));
+    if (nl) {
+      p_ = static_cast<const char*>(nl) + 1;
+      ++line_;
+    } else {
+      p_ = end_;
+    }
+  }
+
+  //! The rest of the current line without its line end; the scanner moves past it.
+  std::string_view rest_of_line() {
+    const char* start = p_;
+    const void* nl = std::memchr(p_, '\n', static_cast<std::size_t>(end_ - p_));
+    const char* stop = nl ? static_cast<const char*>(nl) : end_;
+    p_ = stop;
+    while (stop > start && (stop[-1] == '\r')) --stop;
+    return {start, static_cast<std::size_t>(stop - start)};
+  }
+
+  bool at_end() const { return p_ == end_; }
+  std::size_t line() const { return line_; }
+  std::size_t remaining() const { return static_cast<std::size_t>(end_ - p_); }
+  std::size_t offset() const { return static_cast<std::size_t>(p_ - begin_); }
+  const std::string& name() const { return name_; }
+
+  //! The line to name in a message: at the end of a file that ends with a line break,
+  //! the last line rather than the empty one after it.
+  std::size_t error_line() const {
+    return p_ == end_ && p_ > begin_ && p_[-1] == '\n' && line_ > 1 ? line_ - 1 : line_;
+  }
+  [[noreturn]] void fail(const std::string& what) const { fail_line(name_, error_line(), what); }
+  //! "expected <what>, found <token>" at the current line.
+  [[noreturn]] void fail_expected(const std::string& what, std::string_view found) const {
+    fail(what.empty() ? "unexpected " + quote(found, p_ == end_)
+                      : "expected " + what + ", found " + quote(found, p_ == end_));
+  }
+
+ private:
+  static bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\v' || c == '\f'; }
+
+  bool is_continuation(const char* p) const {
+    ++p;
+    if (p < end_ && *p == '\r') ++p;
+    return p == end_ || *p == '\n';
+  }
+
+  void skip_space_in_line() {
+    for (;;) {
+      while (p_ < end_ && (*p_ == ' ' || *p_ == '\t' || *p_ == '\r' || *p_ == '\v' || *p_ == '\f')) ++p_;
+      if (p_ == end_) return;
+      if (comment_ && *p_ == comment_) {
+        const void* nl = std::memchr(p_, '\n', static_cast<std::size_t>(end_ - p_));
+        p_ = nl ? static_cast<const char*>(nl) : end_;
+        return;
+      }
+      if (continuation_ && *p_ == '\\' && is_continuation(p_)) {
+        ++p_;
+        if (p_ < end_ && *p_ == '\r') ++p_;
+        if (p_ < end_) {
+          ++p_;
+          ++line_;
+        }
+        continue;
+      }
+      return;
+    }
+  }
+
+  const char* begin_;
+  const char* p_;
+  const char* end_;
+  std::size_t line_ = 1;
+  const std::string& name_;
+  char comment_;
+  bool continuation_;
+};
+
+//! Colours in files are 0..255 integers or 0..1 reals; channels hold u8.
+inline std::uint8_t color_from_real(double v) {
+  if (!(v > 0.0)) return 0;  // also NaN
+  if (v >= 1.0) return 255;
+  return static_cast<std::uint8_t>(v * 255.0 + 0.5);
+}
+inline std::uint8_t color_from_integer(double v) {
+  if (!(v > 0.0)) return 0;
+  if (v >= 255.0) return 255;
+  return static_cast<std::uint8_t>(v + 0.5);
+}
+
+//! Reads a "color" channel (u8 x4 or f32 x4, any domain) as RGBA bytes; nullptr when absent
+//! or of another layout.
+struct ColorView {
+  const Channel* channel = nullptr;
+  explicit operator bool() const { return channel != nullptr; }
+  std::array<std::uint8_t, 4> operator[](std::size_t i) const;
+};
+ColorView find_color(const Soup& soup, Domain domain);
+
+//! The channel `name` of `domain` when it has exactly this layout, else nullptr.
+const Channel* find_channel(const Soup& soup, const std::string& name, Domain domain, ScalarType scalar,
+                            int components);
+
+}  // namespace hedge::io_detail
