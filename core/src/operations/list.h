@@ -4,4 +4,5 @@
 
 #define HEDGE_OPERATIONS(X) \
   X(report)             \
-  X(subdivide)
+  X(subdivide)          \
+  X(smooth)
