@@ -5,4 +5,5 @@
 #define HEDGE_OPERATIONS(X) \
   X(report)             \
   X(subdivide)          \
-  X(smooth)
+  X(smooth)             \
+  X(make_delaunay)
