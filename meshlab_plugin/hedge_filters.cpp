@@ -1,0 +1,118 @@
+// Catalogue -> MeshLab filters, independent of the plugin API version. See hedge_filters.h.
+#include "hedge_filters.h"
+
+#include <algorithm>
+#include <charconv>
+#include <climits>
+#include <cmath>
+#include <new>
+
+#include "cmesh_soup.h"
+#include "hedge/error.h"
+
+namespace hedge::meshlab {
+
+QString filter_name(const Operation& op) { return QString::fromStdString("Hedge: " + op.title); }
+
+QString filter_info(const Operation& op) {
+  QString html = QString::fromStdString(op.help).toHtmlEscaped();
+  html.replace("\n", "<br>");
+  return html;
+}
+
+int filter_class(const Operation& op) {
+  // MeshLab's FilterClass bits (interfaces.h in 2020.09, filter_plugin.h in 2022+).
+  if (op.category == "Cleaning") return 0x00002;
+  if (op.category == "Remeshing") return 0x00004;
+  if (op.category == "Smoothing") return 0x00080;
+  if (op.category == "Measure") return 0x10000;
+  return 0x00000;  // Generic
+}
+
+RichKind rich_kind(const ParamSpec& spec) {
+  switch (spec.type) {
+    case ParamType::boolean: return RichKind::boolean;
+    case ParamType::integer: return RichKind::integer;
+    case ParamType::choice: return RichKind::choice;
+    case ParamType::real:
+      return std::isfinite(spec.min) && std::isfinite(spec.max) && spec.max - spec.min <= 1e6 ? RichKind::bounded_real
+                                                                                             : RichKind::real;
+  }
+  return RichKind::real;
+}
+
+const char* rich_type_name(RichKind kind) {
+  switch (kind) {
+    case RichKind::boolean: return "RichBool";
+    case RichKind::integer: return "RichInt";
+    case RichKind::real: return "RichFloat";
+    case RichKind::bounded_real: return "RichDynamicFloat";
+    case RichKind::choice: return "RichEnum";
+  }
+  return "RichFloat";
+}
+
+QString param_tooltip(const ParamSpec& spec) {
+  return QString::fromStdString(spec.help + " [" + spec.id + ": " + spec.range_text() + ", default " +
+                                spec.default_text() + "]");
+}
+
+int int_bound(double bound) { return static_cast<int>(std::clamp(bound, double(INT_MIN), double(INT_MAX))); }
+
+double real_from_float(float value) {
+  char text[32];
+  auto written = std::to_chars(text, text + sizeof text, value);
+  double exact = value;
+  if (written.ec == std::errc()) std::from_chars(text, written.ptr, exact);
+  return exact;
+}
+
+QStringList run_on_model(const Operation& op, const std::map<std::string, Value>& given, MeshModel& model,
+                         vcg::CallBackPos* cb) {
+  const QString name = filter_name(op);
+  const ParamValues values = resolve_params(op, given);  // refuses out-of-range values before any work
+
+  // MeshLab's callback takes whole percents and a C string that must outlive the call; calls
+  // that would change neither are skipped (both hosts redraw on each one).
+  std::string text;
+  int last_percent = -1;
+  std::string last_stage;
+  Progress progress([&](double fraction, const std::string& stage) {
+    if (cb == nullptr) return true;
+    const int percent = std::clamp(static_cast<int>(fraction * 100.0), 0, 100);
+    if (percent == last_percent && stage == last_stage) return true;
+    last_percent = percent;
+    last_stage = stage;
+    text = name.toStdString() + ": " + stage;
+    return cb(percent, text.c_str());
+  });
+
+  const Soup input = soup_from_mesh(model);
+  RunResult result = run_operation(op, input, values, progress);
+
+  QStringList lines;
+  auto line = [&](const std::string& s) { lines << name + ": " + QString::fromStdString(s); };
+  if (op.changes_mesh) {
+    MeshWriteReport written;
+    try {
+      written = write_soup_to_mesh(result.soup, input, model);
+    } catch (const std::bad_alloc&) {
+      // Only allocation can fail while writing; put the input back, which needs no more memory than it had.
+      result = {};
+      try {
+        write_soup_to_mesh(input, input, model);
+      } catch (const std::bad_alloc&) {
+        throw Error("out of memory while writing the result into MeshLab; the mesh could not be restored");
+      }
+      throw Error("out of memory while writing the result into MeshLab; the mesh was restored");
+    }
+    if (written.polygons_triangulated)
+      line(std::to_string(written.polygons_triangulated) + " polygons stored as triangle fans with faux edges");
+    if (written.edges_dropped) line(std::to_string(written.edges_dropped) + " edge elements (wireframe) dropped");
+  }
+  for (const auto& [key, value] : result.report.entries) line(key + " = " + value_text(value));
+  for (const auto& message : result.report.messages) line(message);
+  return lines;
+}
+
+}  // namespace hedge::meshlab

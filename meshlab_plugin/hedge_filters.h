@@ -1,0 +1,47 @@
+// What a MeshLab filter plugin makes of the catalogue, whatever the plugin API version
+// (2020.09 MeshFilterInterface, 2022+ FilterPlugin): names, help, parameter kinds and the run.
+#pragma once
+
+#include <common/meshmodel.h>
+
+#include <QString>
+#include <QStringList>
+#include <map>
+#include <string>
+
+#include "hedge/catalogue.h"
+
+namespace hedge::meshlab {
+
+//! "Hedge: Decimate": the menu entry and the name .mlx scripts use.
+QString filter_name(const Operation& op);
+//! The catalogue's help as MeshLab's rich text.
+QString filter_info(const Operation& op);
+//! MeshLab's FilterClass value for the catalogue category (the values are the same in 2020.09
+//! and 2022+): Remeshing, Smoothing, Cleaning, Measure; anything else Generic.
+int filter_class(const Operation& op);
+
+//! Which Rich parameter class holds a parameter.
+enum class RichKind { boolean, integer, real, bounded_real, choice };
+//! Reals with a finite range (up to 1e6 wide) get a slider (RichDynamicFloat); reals whose
+//! maximum only means "no limit" (1e30) are plain RichFloat fields.
+RichKind rich_kind(const ParamSpec& spec);
+//! "RichBool", "RichInt", "RichFloat", "RichDynamicFloat", "RichEnum", as .mlx scripts spell them.
+const char* rich_type_name(RichKind kind);
+//! The help, then what is allowed, the default and the name to use in scripts.
+QString param_tooltip(const ParamSpec& spec);
+//! An integer range clamped to what MeshLab's int parameters hold.
+int int_bound(double bound);
+
+//! A MeshLab float (single precision) as the decimal a person typed: 0.1f -> 0.1, not
+//! 0.100000001, so that a range's ends stay allowed.
+double real_from_float(float value);
+
+//! Runs `op` on the mesh of `model`: checks the parameters (resolve_params), reads the mesh,
+//! runs the operation with progress through `cb`, and writes the result back. Returns the lines
+//! to log (the operation's report, what building repaired). Throws Error, and then `model` is
+//! untouched: nothing is written before the result is complete.
+QStringList run_on_model(const Operation& op, const std::map<std::string, Value>& given, MeshModel& model,
+                         vcg::CallBackPos* cb);
+
+}  // namespace hedge::meshlab
