@@ -6,4 +6,6 @@
   X(report)             \
   X(subdivide)          \
   X(smooth)             \
-  X(make_delaunay)
+  X(make_delaunay)      \
+  X(fill_holes)         \
+  X(repair)

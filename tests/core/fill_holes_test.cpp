@@ -1,0 +1,386 @@
+// Tests of hole filling (fill_holes.h): every hole within the limit closed, watertight
+// results, large holes skipped, smooth faired patches, attributes carried, huge holes.
+#include "hedge/fill_holes.h"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <numbers>
+#include <set>
+#include <vector>
+
+#include "hedge/build.h"
+#include "hedge/io.h"
+#include "hedge/report.h"
+#include "hedge/topology.h"
+#include "hedge/validate.h"
+
+namespace hedge {
+namespace {
+
+#define ASSERT_VALID(mesh)            \
+  do {                                \
+    Validation v_ = validate(mesh);   \
+    ASSERT_TRUE(v_.ok) << v_.message; \
+  } while (0)
+
+std::vector<std::size_t> loop_lengths(const Mesh& mesh) {
+  std::vector<char> seen(mesh.halfedges_size(), 0);
+  std::vector<std::size_t> out;
+  for (Halfedge h : mesh.halfedges()) {
+    if (!mesh.is_boundary(h) || seen[h.idx()]) continue;
+    std::size_t n = 0;
+    for (Halfedge g : mesh.loop(h)) {
+      seen[g.idx()] = 1;
+      ++n;
+    }
+    out.push_back(n);
+  }
+  return out;
+}
+
+// Closed: no boundary half-edge, so every edge has two faces.
+bool watertight(const Mesh& mesh) {
+  for (Halfedge h : mesh.halfedges())
+    if (mesh.is_boundary(h)) return false;
+  return true;
+}
+
+std::size_t multi_edges(const Mesh& mesh) { return mesh_statistics(mesh).multi_edges; }
+
+// A unit sphere with the cap above polar angle `hole_degrees` removed (a hole of
+// `segments` edges); the south pole is closed by a fan. Outward orientation.
+Soup sphere_with_hole(int segments, double hole_degrees) {
+  Soup s;
+  const double step = 2 * std::numbers::pi / segments;
+  const double theta0 = hole_degrees * std::numbers::pi / 180;
+  const int rings = int(std::round((std::numbers::pi - theta0) / step));
+  for (int k = 0; k < rings; ++k) {
+    const double theta = theta0 + (std::numbers::pi - theta0) * k / rings;
+    for (int j = 0; j < segments; ++j) {
+      const double phi = j * step;
+      s.positions.push_back(Point{
+          {float(std::sin(theta) * std::cos(phi)), float(std::sin(theta) * std::sin(phi)), float(std::cos(theta))}});
+    }
+  }
+  const std::uint32_t pole = std::uint32_t(s.positions.size());
+  s.positions.push_back(Point{{0, 0, -1}});
+  auto id = [&](int k, int j) { return std::uint32_t(k * segments + (j % segments)); };
+  for (int k = 0; k + 1 < rings; ++k)
+    for (int j = 0; j < segments; ++j) {
+      s.add_face({id(k, j), id(k + 1, j), id(k + 1, j + 1)});
+      s.add_face({id(k, j), id(k + 1, j + 1), id(k, j + 1)});
+    }
+  for (int j = 0; j < segments; ++j) s.add_face({id(rings - 1, j), pole, id(rings - 1, j + 1)});
+  return s;
+}
+
+// An n x n grid of unit squares (triangulated) in the plane z = 0, with the squares whose
+// centre lies within `hole_radius` of the middle left out.
+Soup grid_with_hole(int n, double hole_radius) {
+  Soup s;
+  for (int y = 0; y <= n; ++y)
+    for (int x = 0; x <= n; ++x) s.positions.push_back(Point{{float(x), float(y), 0}});
+  auto id = [&](int x, int y) { return std::uint32_t(y * (n + 1) + x); };
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n; ++x) {
+      double cx = x + 0.5 - n / 2.0, cy = y + 0.5 - n / 2.0;
+      if (std::hypot(cx, cy) < hole_radius) continue;
+      s.add_face({id(x, y), id(x + 1, y), id(x + 1, y + 1)});
+      s.add_face({id(x, y), id(x + 1, y + 1), id(x, y + 1)});
+    }
+  return s;
+}
+
+Mesh load(const std::string& name) { return build(read_mesh(std::string(HEDGE_MESH_DIR) + "/" + name)).mesh; }
+
+bool have(const std::string& name) { return std::filesystem::exists(std::string(HEDGE_MESH_DIR) + "/" + name); }
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+TEST(FillHoles, SingleHoleInAPlaneAndItsBorder) {
+  // MeshLab's behaviour: every loop within the limit is a hole, the sheet's border too.
+  Mesh mesh = build(grid_with_hole(12, 3)).mesh;
+  ASSERT_EQ(loop_lengths(mesh).size(), 2u);
+  FillHolesReport r = fill_holes(mesh);
+  ASSERT_VALID(mesh);
+  EXPECT_EQ(r.holes_found, 2u);
+  EXPECT_EQ(r.holes_filled, 2u);
+  EXPECT_EQ(r.holes_skipped, 0u);
+  EXPECT_TRUE(watertight(mesh));
+  EXPECT_EQ(multi_edges(mesh), 0u);
+  EXPECT_GT(r.vertices_added, 0u);  // refined: the outer patch is large
+  EXPECT_EQ(topology_stats(mesh).genus, 0);
+}
+
+TEST(FillHoles, MaxHoleEdgesLeavesLargeHolesOpen) {
+  Mesh mesh = build(grid_with_hole(12, 3)).mesh;
+  std::vector<std::size_t> before = loop_lengths(mesh);
+  std::size_t small = std::min(before[0], before[1]), large = std::max(before[0], before[1]);
+  FillHolesOptions options;
+  options.max_hole_edges = small;
+  FillHolesReport r = fill_holes(mesh, options);
+  ASSERT_VALID(mesh);
+  EXPECT_EQ(r.holes_filled, 1u);
+  EXPECT_EQ(r.holes_skipped, 1u);
+  EXPECT_EQ(r.largest_skipped_edges, large);
+  EXPECT_EQ(loop_lengths(mesh), std::vector<std::size_t>{large});
+  ASSERT_FALSE(r.messages.empty());
+}
+
+TEST(FillHoles, UnrefinedFillAddsOnlyTriangles) {
+  Mesh mesh = build(grid_with_hole(10, 2.5)).mesh;
+  const std::size_t faces = mesh.n_faces(), vertices = mesh.n_vertices();
+  FillHolesOptions options;
+  options.refine = false;
+  options.fair = false;
+  options.max_hole_edges = 30;
+  FillHolesReport r = fill_holes(mesh, options);
+  ASSERT_VALID(mesh);
+  ASSERT_EQ(r.holes_filled, 1u);
+  std::size_t hole = 0;
+  for (std::size_t n : loop_lengths(build(grid_with_hole(10, 2.5)).mesh)) hole = n <= 30 ? n : hole;
+  EXPECT_EQ(mesh.n_vertices(), vertices);
+  EXPECT_EQ(mesh.n_faces(), faces + hole - 2);  // a polygon of n corners takes n - 2 triangles
+  EXPECT_EQ(r.triangles_added, hole - 2);
+  EXPECT_TRUE(mesh.is_triangle_mesh());
+  // A flat hole gets a flat patch: no new triangle bends out of the plane.
+  for (Vertex v : mesh.vertices()) EXPECT_EQ(mesh.position(v)[2], 0.0f);
+}
+
+TEST(FillHoles, FairedPatchFollowsTheSphere) {
+  for (FairingWeights weights : {FairingWeights::cotangent, FairingWeights::uniform}) {
+    Mesh mesh = build(sphere_with_hole(48, 40)).mesh;
+    const std::size_t original = mesh.n_vertices();
+    FillHolesOptions options;
+    options.weights = weights;
+    FillHolesReport r = fill_holes(mesh, options);
+    ASSERT_VALID(mesh);
+    ASSERT_EQ(r.holes_filled, 1u);
+    EXPECT_TRUE(watertight(mesh));
+    ASSERT_GT(r.vertices_added, 50u);
+    double worst = 0, flat_worst = 0;
+    for (Vertex v : mesh.vertices()) {
+      if (v.idx() < original) continue;
+      worst = std::max(worst, std::abs(double(norm(mesh.position(v))) - 1.0));
+    }
+    // Without fairing the patch is a flat disc: the cap's height off the sphere.
+    flat_worst = 1 - std::cos(40 * std::numbers::pi / 180);
+    std::printf(
+        "[ fill_holes ] sphere cap of 40 degrees, %s weights: %zu new vertices, worst radius error %.4f "
+        "(flat patch %.4f)\n",
+        weights == FairingWeights::cotangent ? "cotangent" : "uniform", r.vertices_added, worst, flat_worst);
+    EXPECT_LT(worst, weights == FairingWeights::uniform ? 0.02 : 0.03);
+    // Triangles sized like the sphere's (edge ~ 2 pi / 48 = 0.13).
+    MeshStatistics s = mesh_statistics(mesh);
+    EXPECT_LT(s.edge_length_max, 0.4);
+    EXPECT_GT(s.min_angle_degrees, 5.0);
+  }
+}
+
+TEST(FillHoles, AttributesAreCarried) {
+  Soup soup = grid_with_hole(10, 2.5);
+  const std::size_t nv = soup.n_vertices(), nf = soup.n_faces(), nc = soup.n_corners();
+  Channel& quality = soup.add_channel("quality", Domain::vertex, ScalarType::f32, 1);
+  Channel& material = soup.add_channel("material", Domain::face, ScalarType::i32, 1);
+  Channel& uv = soup.add_channel("uv", Domain::corner, ScalarType::f32, 2);
+  ASSERT_EQ(quality.count(), nv);
+  for (std::size_t v = 0; v < nv; ++v) quality.as<float>()[v] = 1 + soup.positions[v][0];  // 1 .. 11
+  for (std::size_t f = 0; f < nf; ++f) material.as<std::int32_t>()[f] = 7;
+  for (std::size_t c = 0; c < nc; ++c) {
+    const Point& p = soup.positions[soup.corners[c]];
+    uv.as<float>()[2 * c] = p[0] / 10;
+    uv.as<float>()[2 * c + 1] = p[1] / 10;
+  }
+  Mesh mesh = build(soup).mesh;
+  FillHolesOptions options;
+  options.max_hole_edges = 30;
+  FillHolesReport r = fill_holes(mesh, options);
+  ASSERT_VALID(mesh);
+  ASSERT_EQ(r.holes_filled, 1u);
+  ASSERT_GT(r.vertices_added, 0u);
+
+  Soup out = extract(mesh);
+  ASSERT_NO_THROW(out.check());
+  const Channel* q = out.find("quality", Domain::vertex);
+  const Channel* m = out.find("material", Domain::face);
+  const Channel* t = out.find("uv", Domain::corner);
+  ASSERT_TRUE(q && m && t);
+  for (std::size_t v = nv; v < out.n_vertices(); ++v) {
+    // Interpolated quality follows the linear field it was made from.
+    EXPECT_NEAR(q->as<float>()[v], 1 + out.positions[v][0], 0.5f) << v;
+  }
+  for (std::size_t f = 0; f < out.n_faces(); ++f) EXPECT_EQ(m->as<std::int32_t>()[f], 7) << f;
+  // Corner UVs, old corners included, match the planar parameterisation within the patch.
+  for (std::size_t c = 0; c < out.n_corners(); ++c) {
+    const Point& p = out.positions[out.corners[c]];
+    EXPECT_NEAR(t->as<float>()[2 * c], p[0] / 10, 0.05f) << c;
+    EXPECT_NEAR(t->as<float>()[2 * c + 1], p[1] / 10, 0.05f) << c;
+  }
+}
+
+TEST(FillHoles, ProvenanceOfNewElementsStaysDefault) {
+  // A bow-tie vertex makes build() store provenance; new elements must not claim a source,
+  // and extract() must still weld the old copies back.
+  Soup soup = grid_with_hole(8, 2);
+  const std::uint32_t base = std::uint32_t(soup.positions.size());
+  soup.positions.push_back(Point{{-1, -1, 0}});
+  soup.positions.push_back(Point{{0, -1, 0}});
+  soup.add_face({base, base + 1, 0});  // touches the grid at its corner vertex 0 only
+  BuildResult built = build(soup);
+  ASSERT_EQ(built.report.non_manifold_vertices, 1u);
+  Mesh mesh = std::move(built.mesh);
+  FillHolesOptions options;
+  options.max_hole_edges = 20;
+  FillHolesReport r = fill_holes(mesh, options);
+  ASSERT_VALID(mesh);
+  ASSERT_EQ(r.holes_filled, 1u);
+  auto source = mesh.get_vertex_property<std::uint32_t>("hedge:source");
+  ASSERT_TRUE(source);
+  for (Vertex v : mesh.vertices())
+    if (v.idx() >= built.maps.vertex_source.size()) {
+      EXPECT_EQ(source[v], kInvalidIndex);
+    }
+  Soup out = extract(mesh);
+  EXPECT_EQ(out.n_vertices(), soup.n_vertices() + r.vertices_added);  // the copy welded back
+  EXPECT_EQ(out.n_faces(), soup.n_faces() + r.triangles_added);
+}
+
+TEST(FillHoles, ExistingDiagonalIsNotDoubled) {
+  // Two triangles (a,b,c), (a,c,d): the hole on the other side must use b-d, not a-c.
+  Soup soup;
+  soup.positions = {Point{{0, 0, 0}}, Point{{1, 0, 0}}, Point{{1, 1, 0.2f}}, Point{{0, 1, 0}}};
+  soup.add_face({0, 1, 2});
+  soup.add_face({0, 2, 3});
+  Mesh mesh = build(soup).mesh;
+  FillHolesOptions options;
+  options.refine = false;
+  options.fair = false;
+  FillHolesReport r = fill_holes(mesh, options);
+  ASSERT_VALID(mesh);
+  EXPECT_EQ(r.holes_filled, 1u);
+  EXPECT_TRUE(watertight(mesh));
+  EXPECT_EQ(multi_edges(mesh), 0u);
+  EXPECT_TRUE(mesh.find_edge(Vertex(1), Vertex(3)).is_valid());
+}
+
+TEST(FillHoles, LoneTriangleIsNotDoubled) {
+  Soup soup;
+  soup.positions = {Point{{0, 0, 0}}, Point{{1, 0, 0}}, Point{{0, 1, 0}}};
+  soup.add_face({0, 1, 2});
+  Mesh mesh = build(soup).mesh;
+  FillHolesReport r = fill_holes(mesh);
+  ASSERT_VALID(mesh);
+  EXPECT_EQ(r.holes_found, 1u);
+  EXPECT_EQ(r.holes_filled, 0u);
+  EXPECT_EQ(r.holes_skipped, 1u);
+  EXPECT_EQ(mesh.n_faces(), 1u);
+}
+
+TEST(FillHoles, CancelLeavesTheMeshAsItWas) {
+  Mesh mesh = build(sphere_with_hole(32, 50)).mesh;
+  const std::size_t faces = mesh.n_faces(), vertices = mesh.n_vertices();
+  int calls = 0;
+  Progress stop([&](double, const std::string&) { return ++calls < 3; });
+  EXPECT_THROW(fill_holes(mesh, {}, stop), Cancelled);
+  EXPECT_EQ(mesh.n_faces(), faces);
+  EXPECT_EQ(mesh.n_vertices(), vertices);
+  EXPECT_EQ(loop_lengths(mesh).size(), 1u);
+  ASSERT_VALID(mesh);
+}
+
+TEST(FillHoles, TenThousandEdgeHoleFinishes) {
+  // A cylinder of 10,000 segments open at both ends: two holes of 10,000 edges.
+  const int n = 10000;
+  Soup soup;
+  const double edge = 2 * std::numbers::pi / n;
+  for (int k = 0; k < 3; ++k)
+    for (int j = 0; j < n; ++j) {
+      double phi = j * edge;
+      soup.positions.push_back(Point{{float(std::cos(phi)), float(std::sin(phi)), float(k * edge)}});
+    }
+  for (int k = 0; k < 2; ++k)
+    for (int j = 0; j < n; ++j) {
+      std::uint32_t a = k * n + j, b = k * n + (j + 1) % n, c = (k + 1) * n + (j + 1) % n, d = (k + 1) * n + j;
+      soup.add_face({a, b, c});
+      soup.add_face({a, c, d});
+    }
+  Mesh mesh = build(soup).mesh;
+  auto t0 = std::chrono::steady_clock::now();
+  FillHolesReport r = fill_holes(mesh);
+  const double seconds = seconds_since(t0);
+  ASSERT_VALID(mesh);
+  EXPECT_EQ(r.holes_filled, 2u);
+  EXPECT_TRUE(watertight(mesh));
+  EXPECT_EQ(multi_edges(mesh), 0u);
+  EXPECT_LE(r.vertices_added, 2 * FillHolesOptions{}.max_new_vertices_per_hole);
+  MeshStatistics s = mesh_statistics(mesh);
+  std::printf(
+      "[ fill_holes ] two holes of %d edges: %.2f s, %zu vertices and %zu triangles added, min angle %.1f, "
+      "mean quality %.3f\n",
+      n, seconds, r.vertices_added, r.triangles_added, s.min_angle_degrees, s.quality_mean);
+}
+
+TEST(FillHoles, DragonRes4EveryHoleClosed) {
+  if (!have("dragon_res4.ply")) GTEST_SKIP() << "dragon_res4.ply not fetched";
+  Mesh mesh = load("dragon_res4.ply");
+  const std::size_t loops = loop_lengths(mesh).size();
+  auto t0 = std::chrono::steady_clock::now();
+  FillHolesReport r = fill_holes(mesh);
+  const double seconds = seconds_since(t0);
+  ASSERT_VALID(mesh);
+  EXPECT_EQ(r.holes_found, loops);
+  EXPECT_EQ(r.holes_filled + r.holes_skipped, loops);
+  // What is left open is only what may be: lone faces, two-edge slits.
+  EXPECT_EQ(loop_lengths(mesh).size(), r.holes_skipped);
+  for (std::size_t n : loop_lengths(mesh)) EXPECT_LE(n, 3u);
+  std::printf("[ fill_holes ] dragon_res4: %zu holes, %zu filled, %zu skipped, +%zu vertices +%zu triangles, %.2f s\n",
+              r.holes_found, r.holes_filled, r.holes_skipped, r.vertices_added, r.triangles_added, seconds);
+}
+
+TEST(FillHoles, DragonEveryHoleClosed) {
+  if (!have("dragon.ply")) GTEST_SKIP() << "dragon.ply not fetched";
+  Mesh mesh = load("dragon.ply");
+  const MeshStatistics before = mesh_statistics(mesh);
+  auto t0 = std::chrono::steady_clock::now();
+  FillHolesReport r = fill_holes(mesh);
+  const double seconds = seconds_since(t0);
+  ASSERT_VALID(mesh);
+  EXPECT_EQ(r.holes_found, before.topology.boundary_loops);
+  EXPECT_EQ(r.holes_filled + r.holes_skipped, r.holes_found);
+  // The dragon has single triangles floating free: their borders stay, nothing else does.
+  const std::vector<std::size_t> left = loop_lengths(mesh);
+  EXPECT_EQ(left.size(), r.holes_skipped);
+  for (std::size_t n : left) EXPECT_EQ(n, 3u);
+  const MeshStatistics after = mesh_statistics(mesh);
+  EXPECT_EQ(after.multi_edges, 0u);
+  EXPECT_EQ(after.topology.components, before.topology.components);
+  std::printf(
+      "[ fill_holes ] dragon: %zu holes filled (%zu lone triangles left) in %.2f s, +%zu vertices +%zu "
+      "triangles\n",
+      r.holes_filled, r.holes_skipped, seconds, r.vertices_added, r.triangles_added);
+}
+
+TEST(FillHoles, OperationRunsFromTheCatalogue) {
+  const Operation& op = find_operation("fill_holes");
+  EXPECT_EQ(op.category, "Cleaning");
+  RunResult run =
+      run_operation(op, grid_with_hole(10, 2.5),
+                    resolve_params(op, std::map<std::string, std::string>{{"max_hole_edges", "30"}}), Progress::none());
+  ASSERT_TRUE(run.report.find("holes_filled"));
+  EXPECT_EQ(std::get<std::int64_t>(*run.report.find("holes_found")), 2);
+  EXPECT_EQ(std::get<std::int64_t>(*run.report.find("holes_filled")), 1);
+  EXPECT_EQ(std::get<std::int64_t>(*run.report.find("holes_skipped")), 1);
+  BuildResult again = build(run.soup);
+  EXPECT_FALSE(again.report.repaired());
+  EXPECT_EQ(loop_lengths(again.mesh).size(), 1u);
+}
+
+}  // namespace
+}  // namespace hedge
