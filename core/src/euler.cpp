@@ -427,6 +427,10 @@ Halfedge Mesh::split_edge_triangles(Edge e, Vertex v) {
       throw Error("split_edge_triangles: face " + id(face(h).idx()) + " of edge " + id(e.idx()) +
                   " is not a triangle; use split_edge");
   }
+  // Two triangles with the same third corner (a pillow) would get two edges from v to it.
+  if (!is_boundary(e) && to_vertex(next(halfedge(e, 0))) == to_vertex(next(halfedge(e, 1))))
+    throw Error("split_edge_triangles: the two triangles of edge " + id(e.idx()) +
+                " share their third corner; connecting it twice would double an edge");
   Halfedge h = split_edge(e, v);  // v0 -> v
   Halfedge o1 = opposite(next(h));  // v2 -> v
   if (!is_boundary(h)) split_face_by_edge(*this, h, next(next(h)));

@@ -298,7 +298,8 @@ class Mesh {
   Face add_triangle(Vertex a, Vertex b, Vertex c);
   Face add_quad(Vertex a, Vertex b, Vertex c, Vertex d);
   //! Puts a face on a closed chain of boundary half-edges (to_vertex(h[i]) ==
-  //! from_vertex(h[i+1])); throws Error when they are not such a chain.
+  //! from_vertex(h[i+1])); throws Error when they are not such a chain (a whole hole).
+  //! Corner 0 is from_vertex(h[0]), as add_face(vertices) would make it.
   Face add_face(std::span<const Halfedge> halfedges);
   //! Fills the hole whose loop holds boundary half-edge h with one face.
   Face fill_hole(Halfedge h);
@@ -306,43 +307,55 @@ class Mesh {
   void remove_isolated_vertex(Vertex v);
 
   //! A flip is legal on an interior edge between two triangles whose other two vertices
-  //! are not already joined by an edge, and whose end vertices keep valence >= 3.
+  //! are not already joined by an edge, and whose interior end vertices keep valence >= 3
+  //! (a boundary end vertex may drop to 2, as in the two-triangle square).
   bool is_flip_ok(Edge e) const;
-  //! Rotates e inside the quad formed by its two triangles. Precondition: is_flip_ok(e).
+  //! Rotates e inside the quad formed by its two triangles; each face keeps its index and
+  //! one outer edge per side. Throws Error, changing nothing, unless is_flip_ok(e).
   void flip(Edge e);
 
-  //! Inserts v in the middle of e; both faces gain a corner (polygon-aware). Returns the
-  //! half-edge that points to v along halfedge(e, 0)'s direction.
+  //! Inserts v (an isolated vertex) in the middle of e; both faces gain a corner
+  //! (polygon-aware) and keep their corner 0. Returns the half-edge that points to v along
+  //! halfedge(e, 0)'s direction.
   Halfedge split_edge(Edge e, Vertex v);
   //! Splits e at v and connects v to the opposite corner of each adjacent triangle
-  //! (2 triangles become 4). Returns the half-edge that points to v.
+  //! (2 triangles become 4). Returns the half-edge that points to v. Throws Error when a
+  //! face of e is not a triangle or both triangles share their third corner.
   Halfedge split_edge_triangles(Edge e, Vertex v);
-  //! Replaces f by a fan of triangles around the new vertex v (an isolated vertex).
+  //! Replaces f by a fan of triangles around the new vertex v (an isolated vertex); f keeps
+  //! the triangle of its corner 0.
   void split_face(Face f, Vertex v);
 
   //! Legal when h0 and h1 are distinct, non-adjacent half-edges of the same face and
   //! their targets are not joined already.
   bool is_insert_ok(Halfedge h0, Halfedge h1) const;
   //! Splits the face of h0 and h1 by a new edge from to_vertex(h0) to to_vertex(h1).
-  //! Returns the new half-edge from to_vertex(h0) to to_vertex(h1).
+  //! Returns the new half-edge from to_vertex(h0) to to_vertex(h1). The face keeps h0's
+  //! side; the new face (h1's side, corner 0 at to_vertex(h0)) copies its properties.
+  //! Throws Error, changing nothing, unless is_insert_ok(h0, h1).
   Halfedge insert_edge(Halfedge h0, Halfedge h1);
   //! Legal when e is interior, its two faces differ, and merging them gives a face that
   //! visits each vertex once.
   bool is_removal_ok(Edge e) const;
-  //! Merges the two faces of e into one. Precondition: is_removal_ok(e).
+  //! Merges the two faces of e into one; the face with the lower index survives, keeping
+  //! its corner 0. Throws Error, changing nothing, unless is_removal_ok(e).
   void remove_edge(Edge e);
 
   //! Link condition and boundary rules for collapsing h (from_vertex into to_vertex):
   //! the one-rings of the end vertices share only the opposite corners of the incident
-  //! triangles; a boundary edge's vertices; no face would drop below 3 corners without
-  //! being removed cleanly.
+  //! triangles, and no two triangles would coincide (tetrahedron); an interior edge may
+  //! not join two boundary vertices; a triangle at h may not have both other edges on the
+  //! boundary; no other face may pass through both end vertices.
   bool is_collapse_ok(Halfedge h) const;
   //! Moves from_vertex(h) onto to_vertex(h) and removes it, the edge and degenerate
-  //! triangles. Precondition: is_collapse_ok(h).
+  //! triangles (larger polygons lose a corner). Throws Error, changing nothing, unless
+  //! is_collapse_ok(h).
   void collapse(Halfedge h);
 
   //! Splits f into triangles by a fan of new edges from corner 0 (no geometry involved;
-  //! the triangulate operation chooses diagonals by shape).
+  //! the triangulate operation chooses diagonals by shape); O(corners). When a diagonal
+  //! from corner 0 exists already outside f, the fan starts at the next corner that has
+  //! none; throws Error when no corner works.
   void triangulate(Face f);
   void triangulate();
 
