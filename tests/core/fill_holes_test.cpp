@@ -15,6 +15,7 @@
 
 #include "hedge/build.h"
 #include "hedge/io.h"
+#include "hedge/repair.h"
 #include "hedge/report.h"
 #include "hedge/topology.h"
 #include "hedge/validate.h"
@@ -51,6 +52,39 @@ bool watertight(const Mesh& mesh) {
 }
 
 std::size_t multi_edges(const Mesh& mesh) { return mesh_statistics(mesh).multi_edges; }
+
+// Shape of the triangles with index >= first (the patch) and edge lengths of the others.
+struct PatchStats {
+  std::size_t triangles = 0;
+  double min_angle = 180, mean_min_angle = 0, mean_quality = 0, mean_edge = 0, mean_edge_outside = 0;
+};
+PatchStats patch_stats(const Mesh& mesh, std::size_t first) {
+  PatchStats s;
+  std::size_t edges = 0, outside = 0;
+  for (Face f : mesh.faces()) {
+    std::vector<Vec3d> p;
+    for (Vertex v : mesh.vertices(f)) p.push_back(to_double(mesh.position(v)));
+    const bool patch = f.idx() >= first;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      const double l = distance(p[i], p[(i + 1) % p.size()]);
+      (patch ? s.mean_edge : s.mean_edge_outside) += l;
+      ++(patch ? edges : outside);
+    }
+    if (!patch || p.size() != 3) continue;
+    const double a = triangle_min_angle(p[0], p[1], p[2]);
+    s.min_angle = std::min(s.min_angle, a);
+    s.mean_min_angle += a;
+    s.mean_quality += triangle_quality(p[0], p[1], p[2]);
+    ++s.triangles;
+  }
+  if (s.triangles) {
+    s.mean_min_angle /= double(s.triangles);
+    s.mean_quality /= double(s.triangles);
+  }
+  if (edges) s.mean_edge /= double(edges);
+  if (outside) s.mean_edge_outside /= double(outside);
+  return s;
+}
 
 // A unit sphere with the cap above polar angle `hole_degrees` removed (a hole of
 // `segments` edges); the south pole is closed by a fan. Outward orientation.
@@ -117,6 +151,26 @@ TEST(FillHoles, SingleHoleInAPlaneAndItsBorder) {
   EXPECT_EQ(multi_edges(mesh), 0u);
   EXPECT_GT(r.vertices_added, 0u);  // refined: the outer patch is large
   EXPECT_EQ(topology_stats(mesh).genus, 0);
+}
+
+TEST(FillHoles, PatchIsSizedAndShapedLikeItsSurroundings) {
+  Mesh mesh = build(grid_with_hole(30, 8)).mesh;
+  const std::size_t first = mesh.faces_size();
+  FillHolesOptions options;
+  options.max_hole_edges = 100;  // the hole, not the sheet's border
+  FillHolesReport r = fill_holes(mesh, options);
+  ASSERT_VALID(mesh);
+  ASSERT_EQ(r.holes_filled, 1u);
+  const PatchStats s = patch_stats(mesh, first);
+  std::printf(
+      "[ fill_holes ] round hole in a grid: %zu triangles, mean edge %.3f (around: %.3f), min angle %.1f, "
+      "mean min angle %.1f, mean quality %.3f\n",
+      s.triangles, s.mean_edge, s.mean_edge_outside, s.min_angle, s.mean_min_angle, s.mean_quality);
+  EXPECT_GT(s.mean_edge, 0.7 * s.mean_edge_outside);
+  EXPECT_LT(s.mean_edge, 1.4 * s.mean_edge_outside);
+  EXPECT_GT(s.mean_quality, 0.7);
+  EXPECT_GT(s.min_angle, 10.0);
+  for (Vertex v : mesh.vertices()) EXPECT_EQ(mesh.position(v)[2], 0.0f);  // a flat hole stays flat
 }
 
 TEST(FillHoles, MaxHoleEdgesLeavesLargeHolesOpen) {
@@ -342,6 +396,27 @@ TEST(FillHoles, DragonRes4EveryHoleClosed) {
   for (std::size_t n : loop_lengths(mesh)) EXPECT_LE(n, 3u);
   std::printf("[ fill_holes ] dragon_res4: %zu holes, %zu filled, %zu skipped, +%zu vertices +%zu triangles, %.2f s\n",
               r.holes_found, r.holes_filled, r.holes_skipped, r.vertices_added, r.triangles_added, seconds);
+}
+
+TEST(FillHoles, DragonRes4AfterRepairOnlyLoneFacesStayOpen) {
+  if (!have("dragon_res4.ply")) GTEST_SKIP() << "dragon_res4.ply not fetched";
+  // repair removes the pinches that leave two-edge slits; filling then closes every hole
+  // except the borders of lone triangles (the fins of the non-manifold edges).
+  Mesh mesh = load("dragon_res4.ply");
+  repair(mesh);
+  FillHolesReport r = fill_holes(mesh);
+  ASSERT_VALID(mesh);
+  for (std::size_t n : loop_lengths(mesh)) EXPECT_EQ(n, 3u);
+  std::size_t lone = 0;
+  for (Face f : mesh.faces()) {
+    bool alone = true;
+    for (Face g : mesh.faces(f)) alone = alone && !g.is_valid();
+    lone += alone ? 1 : 0;
+  }
+  EXPECT_EQ(loop_lengths(mesh).size(), lone);
+  EXPECT_EQ(r.holes_skipped, lone);
+  std::printf("[ fill_holes ] dragon_res4 after repair: %zu holes, %zu filled, %zu lone triangles left\n",
+              r.holes_found, r.holes_filled, r.holes_skipped);
 }
 
 TEST(FillHoles, DragonEveryHoleClosed) {

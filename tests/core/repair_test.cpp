@@ -134,15 +134,19 @@ TEST(Repair, CountsMatchWhatBuildReported) {
   add_bowtie(soup, 10);
   add_flipped_strip(soup, 20);
   add_book(soup, 30);
+  soup.add_face({0, 0, 1});  // fewer than 3 distinct vertices: build() skips it
+  add_bowtie(soup, 40);      // so that the skipped face is not the last one
   const BuildReport input = build(soup).report;
+  ASSERT_EQ(input.skipped_faces, 1u);
   RunResult run = run_repair(soup);
   EXPECT_EQ(entry(run.report, "non_manifold_edges_split"), std::int64_t(input.non_manifold_edges));
   EXPECT_EQ(entry(run.report, "non_manifold_vertices_split"), std::int64_t(input.non_manifold_vertices));
   EXPECT_EQ(entry(run.report, "vertex_copies_added"), std::int64_t(input.vertex_copies));
   EXPECT_EQ(entry(run.report, "faces_flipped"), std::int64_t(input.flipped_faces));
+  EXPECT_EQ(entry(run.report, "degenerate_faces_removed"), std::int64_t(input.skipped_faces));
   EXPECT_EQ(input.non_manifold_edges, 2u);
   EXPECT_EQ(run.soup.n_vertices(), soup.n_vertices() + input.vertex_copies);
-  EXPECT_EQ(run.soup.n_faces(), soup.n_faces());
+  EXPECT_EQ(run.soup.n_faces(), soup.n_faces() - 1);
   EXPECT_FALSE(build(run.soup).report.repaired());
 }
 

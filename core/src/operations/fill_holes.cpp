@@ -664,11 +664,11 @@ void HoleFiller::finish_attributes() {
       for (std::size_t k = 0; k < corner_channels_.size(); ++k)
         std::memcpy(corner_channels_[k]->element(h.idx()), corner_values_[k].element(slot), corner_values_[k].stride());
       reset_internal(mesh_.halfedge_properties(), h.idx());
-      reset_internal(mesh_.edge_properties(), mesh_.edge(h).idx());
+      if (is_patch_edge(mesh_.edge(h))) reset_internal(mesh_.edge_properties(), mesh_.edge(h).idx());
     }
   }
-  // The border's outer half-edges were boundary and held zeros; they are inside now and
-  // have just been given the corner values above. Nothing else changes outside the patch.
+  // The border half-edges were boundary (holding zeros) and are patch corners now, set
+  // above; the faces and corners outside the patch are left as they were.
 }
 
 }  // namespace
