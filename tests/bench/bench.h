@@ -32,9 +32,9 @@ inline bool repeats_vertex(const std::uint32_t* corners, std::uint32_t n) {
   return false;
 }
 
-//! Counts live heap bytes (malloc_usable_size of every global new/delete, plus glibc's
-//! mallinfo2 as a cross-check for memory that bypasses operator new) between construction
-//! and destruction. One window at a time.
+//! Counts live heap bytes (malloc_usable_size of every malloc/free in the process, with
+//! glibc's own mallinfo2 as a cross-check) between construction and destruction. One
+//! window at a time.
 class HeapWindow {
  public:
   HeapWindow();

@@ -1,17 +1,27 @@
-// Heap counting for hedge_bench: replaces the global operator new/delete (for the whole
-// process, OpenMesh's shared library included) and counts the usable size of every block
-// while a HeapWindow is open. Its own file so the replaced operators are never inlined.
+// Heap counting for hedge_bench: the malloc family is interposed for the whole process
+// (operator new, OpenMesh's shared library and hedge's aligned scratch arrays all end up
+// here), and the usable size of every block is counted while a HeapWindow is open.
+// Counting malloc rather than operator new catches memory that bypasses new
+// (aligned_alloc, posix_memalign), so peaks include every temporary array.
+#include <errno.h>
 #include <malloc.h>
 
-#include <algorithm>
 #include <atomic>
+#include <cstddef>
 #include <cstdint>
-#include <cstdlib>
-#include <new>
 
 #include "bench.h"
 
-// ---- heap counting: every global new/delete goes through here -------------------------
+extern "C" {
+void* __libc_malloc(std::size_t);
+void __libc_free(void*);
+void* __libc_calloc(std::size_t, std::size_t);
+void* __libc_realloc(void*, std::size_t);
+void* __libc_memalign(std::size_t, std::size_t);
+void* __libc_valloc(std::size_t);
+void* __libc_pvalloc(std::size_t);
+}
+
 namespace {
 std::atomic<bool> g_counting{false};
 std::atomic<std::int64_t> g_live{0};
@@ -29,58 +39,57 @@ inline void count_free(void* p) {
   if (!p || !g_counting.load(std::memory_order_relaxed)) return;
   g_live.fetch_sub(static_cast<std::int64_t>(malloc_usable_size(p)), std::memory_order_relaxed);
 }
-inline void* allocate(std::size_t n) {
-  void* p = std::malloc(n ? n : 1);
-  count_alloc(p);
-  return p;
-}
-inline void* allocate_aligned(std::size_t n, std::align_val_t align) {
-  void* p = nullptr;
-  const std::size_t a = std::max(static_cast<std::size_t>(align), sizeof(void*));
-  if (posix_memalign(&p, a, n ? n : 1) != 0) return nullptr;
-  count_alloc(p);
-  return p;
-}
-inline void release(void* p) noexcept {
-  count_free(p);
-  std::free(p);
-}
 }  // namespace
 
-void* operator new(std::size_t n) {
-  if (void* p = allocate(n)) return p;
-  throw std::bad_alloc();
+extern "C" {
+void* malloc(std::size_t n) {
+  void* p = __libc_malloc(n);
+  count_alloc(p);
+  return p;
 }
-void* operator new[](std::size_t n) {
-  if (void* p = allocate(n)) return p;
-  throw std::bad_alloc();
+void free(void* p) {
+  count_free(p);
+  __libc_free(p);
 }
-void* operator new(std::size_t n, const std::nothrow_t&) noexcept { return allocate(n); }
-void* operator new[](std::size_t n, const std::nothrow_t&) noexcept { return allocate(n); }
-void* operator new(std::size_t n, std::align_val_t a) {
-  if (void* p = allocate_aligned(n, a)) return p;
-  throw std::bad_alloc();
+void* calloc(std::size_t count, std::size_t size) {
+  void* p = __libc_calloc(count, size);
+  count_alloc(p);
+  return p;
 }
-void* operator new[](std::size_t n, std::align_val_t a) {
-  if (void* p = allocate_aligned(n, a)) return p;
-  throw std::bad_alloc();
+void* realloc(void* p, std::size_t n) {
+  count_free(p);
+  void* q = __libc_realloc(p, n);
+  if (q) {
+    count_alloc(q);
+  } else if (p && n) {
+    count_alloc(p);  // failed: p is still there
+  }
+  return q;
 }
-void* operator new(std::size_t n, std::align_val_t a, const std::nothrow_t&) noexcept { return allocate_aligned(n, a); }
-void* operator new[](std::size_t n, std::align_val_t a, const std::nothrow_t&) noexcept {
-  return allocate_aligned(n, a);
+void* memalign(std::size_t align, std::size_t n) {
+  void* p = __libc_memalign(align, n);
+  count_alloc(p);
+  return p;
 }
-void operator delete(void* p) noexcept { release(p); }
-void operator delete[](void* p) noexcept { release(p); }
-void operator delete(void* p, std::size_t) noexcept { release(p); }
-void operator delete[](void* p, std::size_t) noexcept { release(p); }
-void operator delete(void* p, std::align_val_t) noexcept { release(p); }
-void operator delete[](void* p, std::align_val_t) noexcept { release(p); }
-void operator delete(void* p, std::size_t, std::align_val_t) noexcept { release(p); }
-void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { release(p); }
-void operator delete(void* p, const std::nothrow_t&) noexcept { release(p); }
-void operator delete[](void* p, const std::nothrow_t&) noexcept { release(p); }
-void operator delete(void* p, std::align_val_t, const std::nothrow_t&) noexcept { release(p); }
-void operator delete[](void* p, std::align_val_t, const std::nothrow_t&) noexcept { release(p); }
+void* aligned_alloc(std::size_t align, std::size_t n) { return memalign(align, n); }
+int posix_memalign(void** out, std::size_t align, std::size_t n) {
+  if (align < sizeof(void*) || (align & (align - 1)) != 0) return EINVAL;
+  void* p = memalign(align, n);
+  if (!p) return ENOMEM;
+  *out = p;
+  return 0;
+}
+void* valloc(std::size_t n) {
+  void* p = __libc_valloc(n);
+  count_alloc(p);
+  return p;
+}
+void* pvalloc(std::size_t n) {
+  void* p = __libc_pvalloc(n);
+  count_alloc(p);
+  return p;
+}
+}
 
 namespace bench {
 

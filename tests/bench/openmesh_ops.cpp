@@ -141,6 +141,8 @@ void memory_of(benchmark::State& state, bool reserve) {
     if (reserve) {
       s.reserved_live_bytes = heap.live();
     } else {
+      s.vertices = mesh->n_vertices();
+      s.faces = mesh->n_faces();
       s.live_bytes = heap.live();
       s.peak_bytes = heap.peak();
       s.malloc_bytes = heap.malloc_live();
