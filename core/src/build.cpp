@@ -4,14 +4,20 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cstdlib>
 #include <cstring>
 #include <memory>
 #include <string>
 #include <thread>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
 #include "hedge/error.h"
+
+#ifdef __linux__
+#include <sys/mman.h>
+#endif
 
 #ifdef HEDGE_BUILD_PROFILE
 #include <sys/resource.h>
@@ -48,6 +54,9 @@ constexpr std::uint32_t kDirBit = 0x80000000u;
 
 constexpr std::uint8_t kFaceOk = 0, kFaceRepeats = 1, kFaceSkipped = 2;
 
+// Below this many corners a second thread costs more than it saves.
+constexpr std::size_t kMinParallelCorners = std::size_t(1) << 16;
+
 // Runs fn(begin, end) over [0, n) on two threads when n is large enough to pay for
 // starting one; the split point is fixed, so results do not depend on timing.
 template <class Fn>
@@ -63,11 +72,79 @@ void parallel_ranges(std::size_t n, Fn&& fn) {
   other.join();
 }
 
-// Big scratch arrays whose every element is written before it is read: skip the zero fill.
-template <class T>
-std::unique_ptr<T[]> scratch(std::size_t n) {
-  return std::make_unique_for_overwrite<T[]>(n);
+// Random reads over big arrays wait for memory; asking a few iterations ahead hides it.
+constexpr std::uint32_t kPrefetch = 16;
+inline void prefetch(const void* p) {
+#if defined(__GNUC__)
+  __builtin_prefetch(p);
+#else
+  (void)p;
+#endif
 }
+
+// Memory for the big temporary arrays: uninitialised (every element is written before it
+// is read), and on transparent huge pages where Linux offers them. In a virtual machine a
+// 4 KiB page fault can cost more than writing the page, and these arrays are written once.
+void* allocate_scratch(std::size_t bytes) {
+  constexpr std::size_t kHugePage = std::size_t(2) << 20;
+  void* p = nullptr;
+  if (bytes >= kHugePage) {
+    const std::size_t rounded = (bytes + kHugePage - 1) / kHugePage * kHugePage;
+    p = std::aligned_alloc(kHugePage, rounded);
+#ifdef __linux__
+    if (p) madvise(p, rounded, MADV_HUGEPAGE);  // only a hint: small pages otherwise
+#endif
+  } else {
+    p = std::malloc(bytes ? bytes : 1);
+  }
+  if (!p) throw std::bad_alloc();
+  return p;
+}
+
+struct FreeScratch {
+  void operator()(void* p) const { std::free(p); }
+};
+
+//! An uninitialised array of n trivial T in scratch memory.
+template <class T>
+class Scratch {
+  static_assert(std::is_trivially_copyable_v<T> && std::is_trivially_destructible_v<T>);
+
+ public:
+  Scratch() = default;
+  explicit Scratch(std::size_t n) : memory_(allocate_scratch(n * sizeof(T))), bytes_(n * sizeof(T)) {
+    data_ = new (memory_.get()) T[n];
+  }
+  T& operator[](std::size_t i) { return data_[i]; }
+  const T& operator[](std::size_t i) const { return data_[i]; }
+  T* get() { return data_; }
+  const T* get() const { return data_; }
+  explicit operator bool() const { return data_ != nullptr; }
+  void reset() {
+    memory_.reset();
+    bytes_ = 0;
+    data_ = nullptr;
+  }
+
+  //! Ends this array and reuses its memory for n U, saving the page faults of a new block.
+  template <class U>
+  Scratch<U> reuse_as(std::size_t n) && {
+    if (n * sizeof(U) > bytes_) return Scratch<U>(n);
+    Scratch<U> out;
+    out.memory_ = std::move(memory_);
+    out.bytes_ = bytes_;
+    out.data_ = new (out.memory_.get()) U[n];
+    data_ = nullptr;
+    return out;
+  }
+
+ private:
+  template <class>
+  friend class Scratch;
+  std::unique_ptr<void, FreeScratch> memory_;
+  std::size_t bytes_ = 0;
+  T* data_ = nullptr;
+};
 
 // Number of distinct values among v[0..n); small faces without allocating.
 std::uint32_t distinct_count(const std::uint32_t* v, std::uint32_t n, std::vector<std::uint32_t>& buffer) {
@@ -115,13 +192,19 @@ bool link_corners(const VertexCorner* e, std::uint32_t k, std::uint32_t* succ,
                   std::vector<std::pair<std::uint32_t, std::uint32_t>>& by_next,
                   std::vector<std::pair<std::uint32_t, std::uint32_t>>& by_prev) {
   if (k <= 32) {
-    for (std::uint32_t i = 0; i < k; ++i) succ[i] = kInv;
-    for (std::uint32_t i = 1; i < k; ++i)
-      for (std::uint32_t j = 0; j < i; ++j) {
-        if (e[j].next == e[i].next || e[j].prev == e[i].prev) return false;
-        if (e[j].prev == e[i].next) succ[i] = j;
-        if (e[i].prev == e[j].next) succ[j] = i;
-      }
+    // Branch-free and in registers: which pairs match is unpredictable.
+    bool twice = false;
+    for (std::uint32_t i = 1; i < k; ++i) {
+      const std::uint32_t next = e[i].next, prev = e[i].prev;
+      for (std::uint32_t j = 0; j < i; ++j) twice |= (e[j].next == next) | (e[j].prev == prev);
+    }
+    if (twice) return false;
+    for (std::uint32_t i = 0; i < k; ++i) {
+      const std::uint32_t next = e[i].next;
+      std::uint32_t s = kInv;
+      for (std::uint32_t j = 0; j < k; ++j) s = e[j].prev == next ? j : s;
+      succ[i] = s;
+    }
     return true;
   }
   // A hub vertex: sort instead of comparing all pairs.
@@ -200,27 +283,55 @@ class Builder {
   const std::vector<std::uint32_t>& moff() const { return identity_ ? soff_ : moff_; }
   std::size_t n_mesh_faces() const { return nf_ - result_.report.skipped_faces; }
 
-  // Offsets, and the faces that repeat a vertex or are too degenerate to build.
+  // Offsets, the faces that repeat a vertex or are too degenerate to build, and the
+  // number of corners of each vertex in built faces (per half of the faces, so that the
+  // fast path can fill its corner lists on two threads).
   void classify_faces() {
     soff_.resize(nf_ + 1);
-    status_.assign(nf_, kFaceOk);
-    std::vector<std::uint32_t> buffer;
     std::uint32_t offset = 0;
     for (std::size_t f = 0; f < nf_; ++f) {
       soff_[f] = offset;
-      const std::uint32_t size = soup_.face_sizes[f];
-      const std::uint32_t distinct = distinct_count(corner_ + offset, size, buffer);
-      if (distinct < 3) {
-        status_[f] = kFaceSkipped;
-        result_.maps.skipped_faces.push_back(static_cast<std::uint32_t>(f));
-      } else if (distinct < size) {
-        status_[f] = kFaceRepeats;
-        ++result_.report.repeated_vertex_faces;
-      }
-      offset += size;
+      offset += soup_.face_sizes[f];
     }
     soff_[nf_] = offset;
+    status_.assign(nf_, kFaceOk);
+    fmid_ = nf_;
+    if (nc_ >= kMinParallelCorners && std::thread::hardware_concurrency() >= 2)
+      fmid_ = static_cast<std::size_t>(std::upper_bound(soff_.begin(), soff_.end(), offset / 2) - soff_.begin()) - 1;
+    struct Part {
+      std::vector<std::uint32_t> skipped;
+      std::size_t repeats = 0;
+    } parts[2];
+    auto work = [&](std::size_t fbegin, std::size_t fend, int p) {
+      std::vector<std::uint32_t>& counts = vertex_corners_[p];
+      counts.assign(nv_, 0);
+      std::vector<std::uint32_t> buffer;
+      for (std::size_t f = fbegin; f < fend; ++f) {
+        const std::uint32_t size = soup_.face_sizes[f], b = soff_[f];
+        const std::uint32_t distinct = distinct_count(corner_ + b, size, buffer);
+        if (distinct < 3) {
+          status_[f] = kFaceSkipped;
+          parts[p].skipped.push_back(static_cast<std::uint32_t>(f));
+          continue;
+        }
+        if (distinct < size) {
+          status_[f] = kFaceRepeats;
+          ++parts[p].repeats;
+        }
+        for (std::uint32_t c = b; c < b + size; ++c) ++counts[corner_[c]];
+      }
+    };
+    if (fmid_ < nf_) {
+      std::thread other([&] { work(fmid_, nf_, 1); });
+      work(0, fmid_, 0);
+      other.join();
+    } else {
+      work(0, nf_, 0);
+    }
+    result_.maps.skipped_faces = std::move(parts[0].skipped);
+    result_.maps.skipped_faces.insert(result_.maps.skipped_faces.end(), parts[1].skipped.begin(), parts[1].skipped.end());
     result_.report.skipped_faces = result_.maps.skipped_faces.size();
+    result_.report.repeated_vertex_faces = parts[0].repeats + parts[1].repeats;
     has_repeats_ = result_.report.repeated_vertex_faces > 0;
     has_skipped_ = result_.report.skipped_faces > 0;
     PHASE("faces");
@@ -230,22 +341,27 @@ class Builder {
   // manifold surface, and fans touching at a vertex): everything is decided locally in
   // the corner list of each vertex. Returns false, having built nothing, otherwise.
   bool build_clean() {
-    // Corners per vertex (a counting sort of the corners by vertex).
-    std::vector<std::uint32_t> vstart(nv_ + 1, 0);
-    for (std::size_t c = 0; c < nc_; ++c) ++vstart[corner_[c]];
+    // Corners per vertex: a counting sort, each half of the faces filling its own part of
+    // every vertex's list, so the lists come out in corner order.
+    std::vector<std::uint32_t> vstart(nv_ + 1);
+    std::vector<std::uint32_t>& cursor0 = vertex_corners_[0];
+    std::vector<std::uint32_t>& cursor1 = vertex_corners_[1];
+    const bool two = fmid_ < nf_;
     {
       std::uint32_t sum = 0;
-      for (std::size_t v = 0; v <= nv_; ++v) {
-        const std::uint32_t count = v < nv_ ? vstart[v] : 0;
+      for (std::size_t v = 0; v < nv_; ++v) {
+        const std::uint32_t c0 = cursor0[v], c1 = two ? cursor1[v] : 0;
         vstart[v] = sum;
-        sum += count;
+        cursor0[v] = sum;
+        if (two) cursor1[v] = sum + c0;
+        sum += c0 + c1;
       }
+      vstart[nv_] = sum;
     }
     PHASE("count");
-    auto list = scratch<VertexCorner>(nc_);
-    {
-      std::vector<std::uint32_t> cursor(vstart.begin(), vstart.end() - 1);
-      for (std::size_t f = 0; f < nf_; ++f) {
+    Scratch<VertexCorner> list(nc_);
+    auto fill = [&](std::size_t fbegin, std::size_t fend, std::vector<std::uint32_t>& cursor) {
+      for (std::size_t f = fbegin; f < fend; ++f) {
         const std::uint32_t b = soff_[f], e = soff_[f + 1];
         std::uint32_t prev = corner_[e - 1], cur = corner_[b];
         for (std::uint32_t c = b; c < e; ++c) {
@@ -255,13 +371,22 @@ class Builder {
           cur = next;
         }
       }
+    };
+    if (two) {
+      std::thread other([&] { fill(fmid_, nf_, cursor1); });
+      fill(0, fmid_, cursor0);
+      other.join();
+    } else {
+      fill(0, nf_, cursor0);
     }
+    vertex_corners_[0] = {};
+    vertex_corners_[1] = {};
     PHASE("fill");
 
     // Link the corners around each vertex. out_twin[c] is the twin of the edge leaving
     // corner c: the corner-edge (named by the corner it points to) of the glued face.
-    auto out_twin = scratch<std::uint32_t>(nc_);
-    auto vfirst = scratch<std::uint32_t>(nv_), vlast = scratch<std::uint32_t>(nv_);
+    Scratch<std::uint32_t> out_twin(nc_);
+    Scratch<std::uint32_t> vfirst(nv_), vlast(nv_);
     std::atomic<bool> unclean{false};
     std::vector<std::uint32_t> several[2];  // vertices with more than one fan, per thread
     auto link = [&](std::size_t vbegin, std::size_t vend, int part) {
@@ -308,14 +433,26 @@ class Builder {
     if (unclean) return false;
     PHASE("link");
 
+    // Keep the corner lists of the vertices with several fans (few), then reuse the lists'
+    // memory for the corner -> half-edge map.
+    several[0].insert(several[0].end(), several[1].begin(), several[1].end());
+    std::vector<VertexCorner> several_lists;
+    std::vector<std::uint32_t> several_start{0};
+    for (std::uint32_t v : several[0]) {
+      several_lists.insert(several_lists.end(), list.get() + vstart[v], list.get() + vstart[v + 1]);
+      several_start.push_back(static_cast<std::uint32_t>(several_lists.size()));
+    }
+    Scratch<std::uint32_t> halfedge_of_corner = std::move(list).reuse_as<std::uint32_t>(nc_);
+
     // Edges: a glued pair shares one, in the order of its first corner.
-    auto halfedge_of_corner = scratch<std::uint32_t>(nc_);
     std::uint32_t* H = halfedge_of_corner.get();
     std::uint32_t ne = 0;
     for (std::size_t f = 0; f < nf_; ++f) {
       std::uint32_t prev = soff_[f + 1] - 1;
       for (std::uint32_t m = soff_[f]; m < soff_[f + 1]; ++m) {
         const std::uint32_t t = out_twin[prev];
+        // The twin's half-edge is a random read; fetch the one a few corners ahead.
+        if (m + kPrefetch < nc_ && out_twin[m + kPrefetch] < m) prefetch(H + out_twin[m + kPrefetch]);
         H[m] = (t == kInv || t > m) ? 2 * ne++ : H[t] ^ 1u;
         prev = m;
       }
@@ -357,15 +494,15 @@ class Builder {
 
     // Vertices with several fans (touching at a vertex only): each fan after the first, in
     // the order of their lowest corner, becomes a copy.
-    several[0].insert(several[0].end(), several[1].begin(), several[1].end());
     if (!several[0].empty()) {
       std::vector<Fan> fans;
       std::vector<std::pair<std::uint32_t, std::uint32_t>> by_next, by_prev;
       std::vector<std::uint32_t> links;
       std::vector<std::uint8_t> visited;
-      for (std::uint32_t v : several[0]) {
-        const std::uint32_t k = vstart[v + 1] - vstart[v];
-        const VertexCorner* e = list.get() + vstart[v];
+      for (std::size_t sv = 0; sv < several[0].size(); ++sv) {
+        const std::uint32_t v = several[0][sv];
+        const std::uint32_t k = several_start[sv + 1] - several_start[sv];
+        const VertexCorner* e = several_lists.data() + several_start[sv];
         links.resize(2 * k);
         std::uint32_t *succ = links.data(), *pred = succ + k;
         link_corners(e, k, succ, by_next, by_prev);
@@ -429,6 +566,8 @@ class Builder {
   // The general path: twins by a counting sort of the corner-edges, orientation, non-manifold
   // edges and vertices, faces that visit a vertex twice.
   void build_general() {
+    vertex_corners_[0] = {};
+    vertex_corners_[1] = {};
     const Soup& soup = soup_;
     const BuildOptions& options = options_;
     const std::size_t nv = nv_, nf = nf_, nc = nc_;
@@ -478,7 +617,7 @@ class Builder {
     }
     PHASE("count");
     const std::size_t n_entries = bstart[nv];
-    auto entries = scratch<BucketEntry>(n_entries);
+    Scratch<BucketEntry> entries(n_entries);
     {
       std::vector<std::uint32_t> cursor(bstart.begin(), bstart.end() - 1);
       for (std::size_t f = 0; f < nf; ++f) {
@@ -773,7 +912,7 @@ class Builder {
 
     PHASE("corners+rep");
     // ---- 7. edges: a glued pair shares one edge, everything else gets an outer half ------
-    auto halfedge_of_corner = scratch<std::uint32_t>(nmc);
+    Scratch<std::uint32_t> halfedge_of_corner(nmc);
     std::uint32_t ne = 0;
     for (std::uint32_t m = 0; m < nmc; ++m) {
       const std::uint32_t t = mtwin[m];
@@ -1025,6 +1164,8 @@ class Builder {
 
   std::vector<std::uint32_t> soff_;   // soup face -> first corner
   std::vector<std::uint8_t> status_;  // kFaceOk, kFaceRepeats or kFaceSkipped
+  std::size_t fmid_ = 0;              // the faces are classified in two halves, split here
+  std::vector<std::uint32_t> vertex_corners_[2];  // corners per vertex in built faces, per half
   bool has_repeats_ = false, has_skipped_ = false;
 
   // Mesh corners: the soup's corners minus skipped faces, flipped faces as c0, cn-1, ..., c1.
@@ -1033,7 +1174,7 @@ class Builder {
   std::vector<std::uint32_t> msrc_;       // mesh corner -> soup corner
   std::vector<std::uint32_t> face_source_;  // mesh face -> soup face
   std::vector<std::uint8_t> flipped_;     // per soup face; empty when nothing flipped
-  std::unique_ptr<std::uint32_t[]> halfedge_of_corner_;  // mesh corner -> half-edge pointing to it
+  Scratch<std::uint32_t> halfedge_of_corner_;  // mesh corner -> half-edge pointing to it
   std::vector<std::uint32_t> copy_source_;  // mesh vertex nv_ + i copies soup vertex copy_source_[i]
   std::size_t n_repeat_cuts_ = 0, n_glued_by_flip_ = 0;
 #ifdef HEDGE_BUILD_PROFILE
