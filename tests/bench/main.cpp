@@ -32,74 +32,9 @@ Input g_input;
 
 const Input& input() { return g_input; }
 
-#ifndef HEDGE_BENCH_HAVE_PLY
-// Stand-in until hedge's PLY reader lands: ASCII or binary little-endian PLY with float
-// x y z first and a "vertex_indices" list of uchar/int. Removed once read_mesh reads PLY.
-hedge::Soup read_ply_stand_in(const std::string& path) {
-  std::FILE* file = std::fopen(path.c_str(), "rb");
-  if (!file) throw hedge::Error(path + ": cannot open");
-  std::string bytes;
-  char buf[1 << 16];
-  for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, file)) > 0;) bytes.append(buf, n);
-  std::fclose(file);
-  const std::size_t header_end = bytes.find("end_header\n");
-  if (header_end == std::string::npos) throw hedge::Error(path + ": no PLY header");
-  const std::string header = bytes.substr(0, header_end);
-  std::size_t nv = 0, nf = 0, vertex_props = 0;
-  bool binary = header.find("binary_little_endian") != std::string::npos;
-  {
-    std::size_t pos = 0;
-    bool in_vertex = false;
-    while (pos < header.size()) {
-      std::size_t eol = header.find('\n', pos);
-      if (eol == std::string::npos) eol = header.size();
-      const std::string line = header.substr(pos, eol - pos);
-      pos = eol + 1;
-      if (std::sscanf(line.c_str(), "element vertex %zu", &nv) == 1)
-        in_vertex = true;
-      else if (std::sscanf(line.c_str(), "element face %zu", &nf) == 1)
-        in_vertex = false;
-      else if (in_vertex && line.rfind("property float", 0) == 0)
-        ++vertex_props;
-    }
-  }
-  hedge::Soup soup;
-  soup.positions.resize(nv);
-  soup.face_sizes.assign(nf, 3);
-  soup.corners.resize(3 * nf);
-  const char* p = bytes.data() + header_end + 11;
-  if (binary) {
-    for (std::size_t v = 0; v < nv; ++v, p += 4 * vertex_props) std::memcpy(&soup.positions[v], p, 12);
-    for (std::size_t f = 0; f < nf; ++f) {
-      if (static_cast<unsigned char>(*p) != 3) throw hedge::Error(path + ": stand-in reader takes triangles only");
-      std::memcpy(&soup.corners[3 * f], p + 1, 12);
-      p += 13;
-    }
-  } else {
-    char* end = nullptr;
-    for (std::size_t v = 0; v < nv; ++v) {
-      for (int k = 0; k < 3; ++k, p = end) soup.positions[v][k] = std::strtof(p, &end);
-      for (std::size_t k = 3; k < vertex_props; ++k, p = end) std::strtof(p, &end);
-    }
-    for (std::size_t f = 0; f < nf; ++f) {
-      if (std::strtoul(p, &end, 10) != 3) throw hedge::Error(path + ": stand-in reader takes triangles only");
-      p = end;
-      for (int k = 0; k < 3; ++k, p = end)
-        soup.corners[3 * f + k] = static_cast<std::uint32_t>(std::strtoul(p, &end, 10));
-    }
-  }
-  soup.check();
-  return soup;
-}
-#endif
-
 void load_input(const std::string& path) {
   g_input.path = path;
-#ifdef HEDGE_BENCH_HAVE_PLY
   g_input.soup = hedge::read_mesh(path);
-#else
-  g_input.soup = read_ply_stand_in(path);
-#endif
   std::vector<std::uint64_t> keys;
   keys.reserve(g_input.soup.n_corners());
   const auto offsets = g_input.soup.face_offsets();
