@@ -228,6 +228,34 @@ TEST(Build, LargeGridTakesTheParallelPaths) {
   EXPECT_EQ(r.mesh.heap_bytes(), expected);
 }
 
+TEST(Build, LargeGridWithDefectsTakesTheGeneralPath) {
+  // Three reversed quads (each the minority of its neighbourhood) and a fourth quad glued
+  // onto an interior edge: the fast path gives up and the general one repairs.
+  Soup soup = grid(300, 250);
+  for (std::uint32_t f : {1000u, 20000u, 60000u}) std::reverse(soup.corners.begin() + 4 * f, soup.corners.begin() + 4 * f + 4);
+  const std::uint32_t a = soup.corners[4 * 500], b = soup.corners[4 * 500 + 1];
+  soup.positions.push_back(Point{{0.5f, 0.5f, 1.0f}});
+  soup.add_face({a, b, std::uint32_t(soup.positions.size() - 1)});
+  BuildResult r = build_and_check(soup);
+  EXPECT_EQ(counts(r.report), (Counts{.non_manifold_edges = 1, .non_manifold_vertices = 2, .vertex_copies = 2, .flipped_faces = 3}));
+}
+
+TEST(Build, LargeCheckerboardOfPinchedVertices) {
+  // Quads on the black squares only: every interior vertex joins two quads at a corner.
+  const int k = 300;
+  Soup soup;
+  for (int y = 0; y <= k; ++y)
+    for (int x = 0; x <= k; ++x) soup.positions.push_back(Point{{float(x), float(y), 0}});
+  auto id = [&](int x, int y) { return std::uint32_t(y * (k + 1) + x); };
+  for (int y = 0; y < k; ++y)
+    for (int x = 0; x < k; ++x)
+      if ((x + y) % 2 == 0) soup.add_face({id(x, y), id(x + 1, y), id(x + 1, y + 1), id(x, y + 1)});
+  BuildResult r = build_and_check(soup);
+  const std::size_t pinched = std::size_t(k - 1) * (k - 1);
+  EXPECT_EQ(counts(r.report), (Counts{.non_manifold_vertices = pinched, .vertex_copies = pinched, .isolated_vertices = 2}));
+  EXPECT_EQ(boundary_loops(r.mesh).size(), soup.n_faces());
+}
+
 // ---- non-manifold input ------------------------------------------------------------------
 
 TEST(Build, NonManifoldEdgeWithThreeFaces) {
@@ -616,7 +644,7 @@ TEST_P(BuildRealMesh, BuildsValidatesAndRoundTrips) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Meshes, BuildRealMesh,
+INSTANTIATE_TEST_SUITE_P(Build, BuildRealMesh,
                          ::testing::Values("bunny.off", "dragon_res4.ply", "dragon_res3.ply", "dragon_res2.ply", "dragon.ply"),
                          [](const auto& info) {
                            std::string name = info.param;
