@@ -132,8 +132,17 @@ bool Mesh::is_quad_mesh() const {
 }
 
 Halfedge Mesh::find_halfedge(Vertex a, Vertex b) const {
-  for (Halfedge h : outgoing(a))
-    if (to_vertex(h) == b) return h;
+  // Both rings hold the edge if it exists: walk them in step, so the cost is
+  // O(min(valence(a), valence(b))) and a fan's apex of huge valence stays cheap to query.
+  const Halfedge start_a = halfedge(a), start_b = halfedge(b);
+  if (!start_a.is_valid() || !start_b.is_valid()) return Halfedge();
+  Halfedge ha = start_a, hb = start_b;
+  do {
+    if (to_vertex(ha) == b) return ha;
+    if (to_vertex(hb) == a) return opposite(hb);
+    ha = ccw_rotated(ha);
+    hb = ccw_rotated(hb);
+  } while (ha != start_a && hb != start_b);
   return Halfedge();
 }
 
