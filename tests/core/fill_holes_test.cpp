@@ -238,6 +238,43 @@ TEST(FillHoles, FairedPatchFollowsTheSphere) {
   }
 }
 
+TEST(FillHoles, FairedPatchFollowsAParaboloid) {
+  // z = r^2 / 40 over a 20 x 20 grid with an 8 x 8 hole: Δ²z = 0, so a consistent
+  // bi-Laplacian puts the patch back on it.
+  auto height = [](double x, double y) { return ((x - 10) * (x - 10) + (y - 10) * (y - 10)) / 40; };
+  Soup soup;
+  for (int y = 0; y <= 20; ++y)
+    for (int x = 0; x <= 20; ++x) soup.positions.push_back(Point{{float(x), float(y), float(height(x, y))}});
+  for (std::uint32_t y = 0; y < 20; ++y)
+    for (std::uint32_t x = 0; x < 20; ++x) {
+      if (x >= 6 && x < 14 && y >= 6 && y < 14) continue;
+      const std::uint32_t a = y * 21 + x, b = a + 1, c = a + 22, d = a + 21;
+      soup.add_face({a, b, c});
+      soup.add_face({a, c, d});
+    }
+  for (FairingWeights weights : {FairingWeights::cotangent, FairingWeights::uniform}) {
+    Mesh mesh = build(soup).mesh;
+    FillHolesOptions options;
+    options.max_hole_edges = 40;
+    options.weights = weights;
+    FillHolesReport r = fill_holes(mesh, options);
+    ASSERT_VALID(mesh);
+    ASSERT_EQ(r.holes_filled, 1u);
+    double worst = 0;
+    for (Vertex v : mesh.vertices())
+      if (v.idx() >= soup.n_vertices()) {
+        const Point& p = mesh.position(v);
+        worst = std::max(worst, std::abs(p[2] - height(p[0], p[1])));
+      }
+    std::printf("[ fill_holes ] paraboloid, hole of 8 x 8 (depth 0.8), %s weights: worst height error %.4f\n",
+                weights == FairingWeights::cotangent ? "cotangent" : "uniform", worst);
+    if (weights == FairingWeights::cotangent)
+      EXPECT_LT(worst, 0.02);
+    else
+      EXPECT_LT(worst, 0.1);
+  }
+}
+
 TEST(FillHoles, AttributesAreCarried) {
   Soup soup = grid_with_hole(10, 2.5);
   const std::size_t nv = soup.n_vertices(), nf = soup.n_faces(), nc = soup.n_corners();
@@ -304,6 +341,36 @@ TEST(FillHoles, ProvenanceOfNewElementsStaysDefault) {
   Soup out = extract(mesh);
   EXPECT_EQ(out.n_vertices(), soup.n_vertices() + r.vertices_added);  // the copy welded back
   EXPECT_EQ(out.n_faces(), soup.n_faces() + r.triangles_added);
+}
+
+TEST(FillHoles, QuadMeshHole) {
+  // Quads around the hole: the patch is triangles, cotangent fairing falls back to uniform.
+  Soup soup;
+  const int n = 12;
+  for (int y = 0; y <= n; ++y)
+    for (int x = 0; x <= n; ++x)
+      soup.positions.push_back(Point{{float(x), float(y), float((x - 6) * (x - 6) + (y - 6) * (y - 6)) / 20}});
+  for (std::uint32_t y = 0; y < n; ++y)
+    for (std::uint32_t x = 0; x < n; ++x) {
+      if (x >= 4 && x < 8 && y >= 4 && y < 8) continue;
+      soup.add_face({y * (n + 1) + x, y * (n + 1) + x + 1, (y + 1) * (n + 1) + x + 1, (y + 1) * (n + 1) + x});
+    }
+  Mesh mesh = build(soup).mesh;
+  FillHolesOptions options;
+  options.max_hole_edges = 16;
+  options.weights = FairingWeights::cotangent;
+  FillHolesReport r = fill_holes(mesh, options);
+  ASSERT_VALID(mesh);
+  EXPECT_EQ(r.holes_filled, 1u);
+  EXPECT_EQ(r.fairing_failures, 0u);
+  EXPECT_EQ(loop_lengths(mesh).size(), 1u);
+  // The paraboloid's hole is filled near the paraboloid (z = r^2 / 20 <= 0.4 there); the
+  // uniform operator, all quads allow, is the less accurate one.
+  for (Vertex v : mesh.vertices())
+    if (v.idx() >= soup.n_vertices()) {
+      const Point& p = mesh.position(v);
+      EXPECT_NEAR(p[2], ((p[0] - 6) * (p[0] - 6) + (p[1] - 6) * (p[1] - 6)) / 20, 0.1) << v.idx();
+    }
 }
 
 TEST(FillHoles, ExistingDiagonalIsNotDoubled) {

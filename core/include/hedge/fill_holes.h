@@ -26,10 +26,11 @@ struct FillHolesOptions {
   //! Move the patch's new vertices to minimise the thin-plate energy (Δ²x = 0) with the
   //! surrounding mesh as boundary condition: a patch that continues the surface smoothly.
   bool fair = true;
-  //! Uniform by default: on Liepa's patches, sampled like their surroundings, it is the
-  //! closer of the two (a faired 40-degree cap of a sphere: 1.2% radius error, cotangent 1.8%)
-  //! and needs one solve where cotangent weights need two (they must be measured on a shape).
-  FairingWeights weights = FairingWeights::uniform;
+  //! Cotangent by default: a consistent Laplace-Beltrami, so a patch in a quadric stays on
+  //! it far better than with the umbrella (paraboloid 0.010 vs 0.055 worst error, sphere cap
+  //! of 30 degrees 0.002 vs 0.042). The weights are measured on the shape a uniform solve
+  //! gives first. Holes bordered by polygons (quads...) use the uniform operator.
+  FairingWeights weights = FairingWeights::cotangent;
   //! Loops up to this many edges get the optimal (O(n³)) triangulation; longer loops are
   //! first cut by short balanced diagonals into pieces of at most `piece_edges` edges.
   std::size_t max_optimal_edges = 300;
