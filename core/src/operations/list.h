@@ -8,4 +8,5 @@
   X(smooth)             \
   X(make_delaunay)      \
   X(fill_holes)         \
-  X(repair)
+  X(repair)             \
+  X(triangulate)
