@@ -100,6 +100,13 @@ TEST(Repair, EveryDefectRepairedAndTheResultBuildsClean) {
   add_duplicate(soup, 40);
   add_near_duplicates(soup, 50);
   add_points(soup, 60, {{0, 0, 0}});  // isolated
+  // Attributes that identify their element, to see them follow.
+  Channel& id = soup.add_channel("id", Domain::vertex, ScalarType::i32, 1);
+  for (std::size_t v = 0; v < soup.n_vertices(); ++v) id.as<std::int32_t>()[v] = std::int32_t(v);
+  Channel& material = soup.add_channel("material", Domain::face, ScalarType::i32, 1);
+  for (std::size_t f = 0; f < soup.n_faces(); ++f) material.as<std::int32_t>()[f] = std::int32_t(f);
+  Channel& corner = soup.add_channel("corner", Domain::corner, ScalarType::i32, 1);
+  for (std::size_t c = 0; c < soup.n_corners(); ++c) corner.as<std::int32_t>()[c] = std::int32_t(soup.corners[c]);
   ASSERT_TRUE(build(soup).report.repaired());
 
   RunResult run = run_repair(soup, {{"weld_distance", "1e-4"}});
@@ -111,6 +118,29 @@ TEST(Repair, EveryDefectRepairedAndTheResultBuildsClean) {
   EXPECT_EQ(entry(run.report, "vertices_welded"), 2);
   EXPECT_EQ(entry(run.report, "isolated_vertices_removed"), 1);
   EXPECT_EQ(entry(run.report, "pinched_faces_removed"), 0);
+
+  ASSERT_NO_THROW(run.soup.check());
+  // Every vertex keeps its own id (copies their source's), and every corner its vertex's.
+  const Channel* out_id = run.soup.find("id", Domain::vertex);
+  const Channel* out_corner = run.soup.find("corner", Domain::corner);
+  ASSERT_TRUE(out_id && out_corner && run.soup.find("material", Domain::face));
+  for (std::size_t v = 0; v < run.soup.n_vertices(); ++v) {
+    const auto source = std::size_t(out_id->as<std::int32_t>()[v]);
+    ASSERT_LT(source, soup.n_vertices());
+    EXPECT_EQ(run.soup.positions[v], soup.positions[source]) << v;
+  }
+  for (std::size_t c = 0; c < run.soup.n_corners(); ++c) {
+    const std::int32_t vertex_id = out_id->as<std::int32_t>()[run.soup.corners[c]];
+    const std::int32_t corner_id = out_corner->as<std::int32_t>()[c];
+    // A welded corner names the vertex it was welded away from; they are 1e-6 apart. The
+    // collapse of the degenerate face (x in 30..32) moves a vertex: its corners keep their
+    // values, as every collapse does.
+    const Point& a = soup.positions[std::size_t(vertex_id)];
+    const Point& b = soup.positions[std::size_t(corner_id)];
+    if (a[0] >= 30 && a[0] <= 32) continue;
+    EXPECT_NEAR(a[0], b[0], 1e-5f);
+    EXPECT_NEAR(a[1], b[1], 1e-5f);
+  }
 
   BuildResult again = build(run.soup);
   EXPECT_FALSE(again.report.repaired()) << again.report.messages.front();
