@@ -62,11 +62,9 @@ MeshFilterInterface::FILTER_ARITY FilterHedgePlugin::filterArity(QAction*) const
 int FilterHedgePlugin::getPreConditions(QAction*) const { return MeshModel::MM_FACENUMBER; }
 
 int FilterHedgePlugin::postCondition(QAction* action) const {
-  if (!operation_of(ID(action)).changes_mesh) return MeshModel::MM_NONE;
-  // The mesh is rebuilt: everything may change, attributes included.
-  return MeshModel::MM_GEOMETRY_AND_TOPOLOGY_CHANGE | MeshModel::MM_VERTCOLOR | MeshModel::MM_VERTQUALITY |
-         MeshModel::MM_VERTTEXCOORD | MeshModel::MM_FACECOLOR | MeshModel::MM_FACEQUALITY | MeshModel::MM_WEDGTEXCOORD |
-         MeshModel::MM_VERTFLAGSELECT | MeshModel::MM_FACEFLAGSELECT;
+  // The mesh is rebuilt. Attribute changes need no bits here: MeshLab compares the data masks
+  // before and after, and colour bits would make the GUI render colours the mesh may not have.
+  return operation_of(ID(action)).changes_mesh ? MeshModel::MM_GEOMETRY_AND_TOPOLOGY_CHANGE : MeshModel::MM_NONE;
 }
 
 void FilterHedgePlugin::initParameterSet(QAction* action, MeshModel&, RichParameterList& parameters) {

@@ -1,0 +1,190 @@
+"""GUI smoke test under Xvfb: MeshLab starts with the plugin, and its Filters menu holds every
+Hedge filter under the submenu of its class; Hedge: Decimate opens its parameter dialog and
+applies from it. The menus are found and read by OCR (tesseract) on screenshots, so no screen
+coordinate is hard-coded; the screenshots stay in the test's output folder."""
+import os
+import re
+import subprocess
+import time
+
+import meshlab_test as mt
+
+# MeshLab 2020.09's Filters submenus for the FilterClass of each catalogue category.
+# Where to read (x, y, w, h): MeshLab opens at the top left of the 1600x1000 screen, menus drop
+# down from the menu bar and submenus open to the right of the Filters menu.
+MENU_BAR = (0, 0, 1200, 26)
+FILTERS_MENU = (0, 20, 700, 560)
+SUBMENU = (480, 0, 1120, 1000)
+DIALOG = (0, 0, 700, 700)
+
+SUBMENUS = {"Remeshing": "Remeshing, Simplification and Reconstruction", "Cleaning": "Cleaning and Repairing",
+            "Smoothing": "Smoothing, Fairing and Deformation", "Measure": "Quality Measure and Computations"}
+
+
+def normal(text):
+    return re.sub(r"[^a-z0-9]", "", text.lower())
+
+
+class Screen:
+    def __init__(self, ml):
+        self.ml = ml
+        self.count = 0
+
+    def xdotool(self, *arguments):
+        subprocess.run(["xdotool", *map(str, arguments)], env=self.ml.env(), check=True, capture_output=True)
+
+    def shot(self, name):
+        path = self.ml.path(f"{self.count:02d}_{name}.png")
+        self.count += 1
+        subprocess.run(["import", "-window", "root", path], env=self.ml.env(), check=True, capture_output=True)
+        return path
+
+    def lines(self, png, region=None, scale=2):
+        """Text lines on the screenshot (optionally only inside region = (x, y, w, h)), each a list
+        of words with their boxes in screen pixels."""
+        scaled = png[:-4] + "_ocr.png"
+        crop = ["-crop", "%dx%d+%d+%d" % (region[2], region[3], region[0], region[1]), "+repage"] if region else []
+        subprocess.run(["convert", png, *crop, "-resize", f"{scale * 100}%", "-colorspace", "Gray", scaled], check=True)
+        tsv = subprocess.run(["tesseract", scaled, "-", "--psm", "11", "tsv"], capture_output=True, text=True,
+                             env=dict(os.environ, OMP_THREAD_LIMIT="1")).stdout
+        os.remove(scaled)
+        dx, dy = (region[0], region[1]) if region else (0, 0)
+        words = []
+        for row in tsv.splitlines()[1:]:
+            cells = row.split("\t")
+            if len(cells) == 12 and cells[0] == "5" and cells[11].strip():
+                x, y, w, h = (int(c) // scale for c in cells[6:10])
+                words.append({"text": cells[11], "x": x + dx, "y": y + dy, "w": w, "h": h})
+        # --psm 11 finds sparse words: gather them into rows by height on the screen, then split
+        # each row, left to right, where the gap is too wide for a space (menu columns).
+        words.sort(key=lambda w: w["y"] + w["h"] / 2)
+        rows = []
+        for word in words:
+            centre = word["y"] + word["h"] / 2
+            if rows and abs(centre - rows[-1][0]) < 6:
+                rows[-1][1].append(word)
+            else:
+                rows.append((centre, [word]))
+        lines = []
+        for _, row in rows:
+            row.sort(key=lambda w: w["x"])
+            for word in row:
+                if lines and lines[-1][-1] in row and 0 <= word["x"] - (lines[-1][-1]["x"] + lines[-1][-1]["w"]) < 25:
+                    lines[-1].append(word)
+                else:
+                    lines.append([word])
+        return lines
+
+    def text(self, png, region=None):
+        return normal(" ".join(word["text"] for line in self.lines(png, region) for word in line))
+
+    def find(self, png, phrase, region=None, scale=2):
+        """The box of the words spelling `phrase` (ignoring case, spaces and punctuation), or None."""
+        target = normal(phrase)
+        for line in self.lines(png, region, scale):
+            for i in range(len(line)):
+                joined = ""
+                for j in range(i, len(line)):
+                    joined += normal(line[j]["text"])
+                    if joined.startswith(target):
+                        x0, x1 = line[i]["x"], line[j]["x"] + line[j]["w"]
+                        y0 = min(w["y"] for w in line[i:j + 1])
+                        y1 = max(w["y"] + w["h"] for w in line[i:j + 1])
+                        return {"x": x0, "y": y0, "w": x1 - x0, "h": y1 - y0}
+                    if not joined or not target.startswith(joined):
+                        break
+        return None
+
+    def click(self, line):
+        x, y = line["x"] + line["w"] // 2, line["y"] + line["h"] // 2
+        self.xdotool("mousemove", x - 5, y, "sleep", "0.2", "mousemove", x, y, "click", "1")
+        time.sleep(1.0)
+
+
+def wait_for(predicate, seconds):
+    deadline = time.monotonic() + seconds
+    while time.monotonic() < deadline:
+        if predicate():
+            return True
+        time.sleep(0.5)
+    return False
+
+
+def main():
+    args = mt.parse_args()
+    checks = mt.Checks()
+    ml = mt.MeshLab(args)
+    log_path = ml.path("meshlab.log")
+    gui = None
+    try:
+        if not checks.check(os.access(ml.gui, os.X_OK), "the PREFIX copy of meshlab exists"):
+            checks.finish()
+        log = open(log_path, "w")
+        gui = subprocess.Popen([ml.gui, ml.mesh("bunny.off")], env=ml.env(), stdout=log, stderr=subprocess.STDOUT,
+                               cwd=ml.out)
+        read_log = lambda: open(log_path, errors="replace").read()
+        started = wait_for(lambda: "All files opened" in read_log(), 60)
+        checks.check(started, "MeshLab starts and opens the bunny")
+        checks.check(os.path.join("meshlab-prefix", "lib") in read_log() or "plugins" in read_log(),
+                     "MeshLab loads plugins from the PREFIX")
+        time.sleep(2)
+        screen = Screen(ml)
+        main_shot = screen.shot("main_window")
+        filters = screen.find(main_shot, "Filters", MENU_BAR, scale=3)
+        if not checks.check(filters is not None, "the menu bar has Filters (OCR)"):
+            raise mt.Failure("no Filters menu on the screen")
+        screen.click(filters)
+        menu_shot = screen.shot("filters_menu")
+        categories = sorted({op["category"] for op in ml.catalogue["operations"]})
+        for category in categories:
+            submenu_title = SUBMENUS.get(category)
+            ops = [op for op in ml.catalogue["operations"] if op["category"] == category]
+            if not submenu_title:
+                checks.check(False, f"no known submenu for category {category} ({[op['filter'] for op in ops]})")
+                continue
+            entry = screen.find(menu_shot, submenu_title.split(",")[0].split(" and ")[0], FILTERS_MENU)
+            if not checks.check(entry is not None, f"Filters menu has '{submenu_title}'"):
+                continue
+            screen.click(entry)
+            shot = screen.shot("submenu_" + category.lower())
+            text = screen.text(shot, SUBMENU)
+            for op in ops:
+                checks.check(normal(op["filter"]) in text, f"'{submenu_title}' lists {op['filter']} ({os.path.basename(shot)})")
+
+        # Apply Hedge: Decimate from its dialog.
+        remeshing = screen.find(menu_shot, "Remeshing", FILTERS_MENU)
+        if remeshing:
+            screen.click(remeshing)
+            decimate = screen.find(screen.shot("submenu_remeshing_again"), "Hedge: Decimate", SUBMENU)
+            if checks.check(decimate is not None, "Hedge: Decimate found in the submenu"):
+                screen.click(decimate)
+                time.sleep(1)
+                dialog = screen.shot("decimate_dialog")
+                dialog_text = screen.text(dialog, DIALOG)
+                for p in ml.operations["decimate"]["params"]:
+                    checks.check(normal(p["label"]) in dialog_text, f"the Decimate dialog shows '{p['label']}'")
+                apply = screen.find(dialog, "Apply", DIALOG)
+                if checks.check(apply is not None, "the dialog has Apply"):
+                    screen.click(apply)
+                    applied = wait_for(lambda: "Hedge: Decimate: faces_after = 1838" in read_log(), 30)
+                    checks.check(applied, "Apply decimates the bunny to half (MeshLab's log)")
+                    time.sleep(1)
+                    after = screen.shot("after_decimate")
+                    checks.check("faces1838" in screen.text(after, (0, 580, 700, 120)), "MeshLab shows 1,838 faces")
+        checks.check(gui.poll() is None, "MeshLab is still running")
+    except mt.Failure as e:
+        checks.check(False, str(e))
+    finally:
+        if gui is not None:
+            gui.terminate()
+            try:
+                gui.wait(10)
+            except subprocess.TimeoutExpired:
+                gui.kill()
+        ml.close()
+    print(f"screenshots in {ml.out}")
+    checks.finish()
+
+
+if __name__ == "__main__":
+    main()
