@@ -185,11 +185,15 @@ struct VertexCorner {
   std::uint32_t corner, prev, next;
 };
 
-// Links the k corners around one vertex: succ[i] = j when the edge leaving corner i is the
-// edge entering corner j, so their faces glue there (kInv: a boundary edge). Returns false
-// when an edge at the vertex has two faces running the same way: the general path's job.
-bool link_corners(const VertexCorner* e, std::uint32_t k, std::uint32_t* succ,
-                  std::vector<std::pair<std::uint32_t, std::uint32_t>>& by_next,
+// Links the k corners around vertex v: succ[i] = j when the edge leaving corner i is the
+// edge entering corner j, so their faces glue there (kInv: a boundary edge). An edge with
+// three or more faces (a non-manifold edge, counted in `non_manifold` at its smaller end)
+// glues its first face of each direction, in face order, as the general path does; both
+// ends of the edge see the same faces in the same order, so they agree without talking.
+// Returns false when an edge has exactly two faces running the same way: gluing them needs
+// a flip, which is the general path's job.
+bool link_corners(const VertexCorner* e, std::uint32_t k, std::uint32_t v, std::uint32_t* succ,
+                  std::size_t& non_manifold, std::vector<std::pair<std::uint32_t, std::uint32_t>>& by_next,
                   std::vector<std::pair<std::uint32_t, std::uint32_t>>& by_prev) {
   if (k <= 32) {
     // Branch-free and in registers: which pairs match is unpredictable.
@@ -198,30 +202,39 @@ bool link_corners(const VertexCorner* e, std::uint32_t k, std::uint32_t* succ,
       const std::uint32_t next = e[i].next, prev = e[i].prev;
       for (std::uint32_t j = 0; j < i; ++j) twice |= (e[j].next == next) | (e[j].prev == prev);
     }
-    if (twice) return false;
-    for (std::uint32_t i = 0; i < k; ++i) {
-      const std::uint32_t next = e[i].next;
-      std::uint32_t s = kInv;
-      for (std::uint32_t j = 0; j < k; ++j) s = e[j].prev == next ? j : s;
-      succ[i] = s;
+    if (!twice) {
+      for (std::uint32_t i = 0; i < k; ++i) {
+        const std::uint32_t next = e[i].next;
+        std::uint32_t s = kInv;
+        for (std::uint32_t j = 0; j < k; ++j) s = e[j].prev == next ? j : s;
+        succ[i] = s;
+      }
+      return true;
     }
-    return true;
   }
-  // A hub vertex: sort instead of comparing all pairs.
+  // Some neighbour is reached by two edges (or a hub vertex): group the edges by neighbour.
+  // Sorting (neighbour, corner) puts each group in face order, since the list is.
   by_next.clear();
   by_prev.clear();
   for (std::uint32_t i = 0; i < k; ++i) {
     by_next.emplace_back(e[i].next, i);
     by_prev.emplace_back(e[i].prev, i);
+    succ[i] = kInv;
   }
   std::sort(by_next.begin(), by_next.end());
   std::sort(by_prev.begin(), by_prev.end());
-  for (std::uint32_t i = 1; i < k; ++i)
-    if (by_next[i].first == by_next[i - 1].first || by_prev[i].first == by_prev[i - 1].first) return false;
-  std::uint32_t j = 0;
-  for (auto [w, i] : by_next) {
-    while (j < k && by_prev[j].first < w) ++j;
-    succ[i] = j < k && by_prev[j].first == w ? by_prev[j].second : kInv;
+  std::uint32_t a = 0, b = 0;
+  while (a < k || b < k) {
+    const std::uint32_t w = std::min(a < k ? by_next[a].first : kInv, b < k ? by_prev[b].first : kInv);
+    std::uint32_t a_end = a, b_end = b;
+    while (a_end < k && by_next[a_end].first == w) ++a_end;
+    while (b_end < k && by_prev[b_end].first == w) ++b_end;
+    const std::uint32_t out = a_end - a, in = b_end - b;
+    if (out + in == 2 && (out == 2 || in == 2)) return false;
+    if (out && in) succ[by_next[a].second] = by_prev[b].second;
+    if (out + in >= 3 && w > v) ++non_manifold;
+    a = a_end;
+    b = b_end;
   }
   return true;
 }
@@ -274,7 +287,7 @@ class Builder {
     phase_cpu0 = cpu_ms();
 #endif
     classify_faces();
-    if (has_skipped_ || has_repeats_ || !build_clean()) build_general();
+    if (has_skipped_ || has_repeats_ || !build_local()) build_general();
     finish();
     return std::move(result_);
   }
@@ -337,10 +350,11 @@ class Builder {
     PHASE("faces");
   }
 
-  // The fast path, for soups whose every edge has at most one face on each side (any
-  // manifold surface, and fans touching at a vertex): everything is decided locally in
-  // the corner list of each vertex. Returns false, having built nothing, otherwise.
-  bool build_clean() {
+  // The fast path, for soups that need no flip and no face skipped or split inside: any
+  // manifold surface, fans touching at a vertex, edges with three or more faces. Everything
+  // is decided locally in the corner list of each vertex. Returns false, having built
+  // nothing, when two faces on an edge run the same way (orientation is global).
+  bool build_local() {
     // Corners per vertex: a counting sort, each half of the faces filling its own part of
     // every vertex's list, so the lists come out in corner order.
     std::vector<std::uint32_t> vstart(nv_ + 1);
@@ -389,6 +403,7 @@ class Builder {
     Scratch<std::uint32_t> vfirst(nv_), vlast(nv_);
     std::atomic<bool> unclean{false};
     std::vector<std::uint32_t> several[2];  // vertices with more than one fan, per thread
+    std::size_t non_manifold[2] = {0, 0};   // non-manifold edges, per thread
     auto link = [&](std::size_t vbegin, std::size_t vend, int part) {
       std::vector<std::pair<std::uint32_t, std::uint32_t>> by_next, by_prev;
       std::vector<std::uint32_t> big;
@@ -405,7 +420,7 @@ class Builder {
         }
         std::uint32_t* pred = succ + k;
         const VertexCorner* e = list.get() + vstart[v];
-        if (!link_corners(e, k, succ, by_next, by_prev)) {
+        if (!link_corners(e, k, static_cast<std::uint32_t>(v), succ, non_manifold[part], by_next, by_prev)) {
           unclean.store(true, std::memory_order_relaxed);
           return;
         }
@@ -431,6 +446,7 @@ class Builder {
       link(0, nv_, 0);
     }
     if (unclean) return false;
+    result_.report.non_manifold_edges = non_manifold[0] + non_manifold[1];
     PHASE("link");
 
     // Keep the corner lists of the vertices with several fans (few), then reuse the lists'
@@ -505,7 +521,8 @@ class Builder {
         const VertexCorner* e = several_lists.data() + several_start[sv];
         links.resize(2 * k);
         std::uint32_t *succ = links.data(), *pred = succ + k;
-        link_corners(e, k, succ, by_next, by_prev);
+        std::size_t counted_already = 0;
+        link_corners(e, k, v, succ, counted_already, by_next, by_prev);
         invert_links(succ, k, pred);
         visited.assign(k, 0);
         bool first_fan = true;
@@ -944,7 +961,8 @@ class Builder {
       }
     });
     PHASE("records");
-    for (std::uint32_t m = 0; m < nmc; ++m) incoming[mvert[m]] = H[m];
+    // The lowest corner's: halfedge(v) of a closed fan is its opposite, as in build_local().
+    for (std::uint32_t m = static_cast<std::uint32_t>(nmc); m-- > 0;) incoming[mvert[m]] = H[m];
     mtwin = {};
     mtwin.shrink_to_fit();
 
@@ -987,7 +1005,7 @@ class Builder {
         }
         const Vertex v(static_cast<Index>(vi));
         if (cycle) {
-          mesh.set_halfedge(v, mesh.next(h0));
+          mesh.set_halfedge(v, opposite(h0));
         } else {
           const Halfedge out = opposite(first), in = opposite(mesh.next(last));
           mesh.set_halfedge(v, out);
@@ -1051,7 +1069,7 @@ class Builder {
             mesh.set_vertex(m, Vertex(id));
           }
           if (cycle) {
-            fans.push_back({id, mesh.next(h0), Halfedge()});
+            fans.push_back({id, opposite(h0), Halfedge()});
           } else {
             const Halfedge in = opposite(mesh.next(last));
             mesh.set_vertex(in, Vertex(id));

@@ -565,6 +565,38 @@ TEST(Build, Deterministic) {
   EXPECT_EQ(signature(build(big).mesh), signature(build(big).mesh));
 }
 
+// The local path decides non-manifold edges and vertices per vertex; the general path
+// (taken when a face is skipped) by sorting all edges. Both must build the same mesh.
+void expect_same_as_general_path(const Soup& soup) {
+  Soup forced = soup;
+  forced.add_face({0, 0, 0});  // skipped: forces the general path, changes nothing else
+  const BuildResult local = build(soup), general = build(forced);
+  EXPECT_EQ(std::get<0>(signature(local.mesh)), std::get<0>(signature(general.mesh)));
+  EXPECT_EQ(std::get<1>(signature(local.mesh)), std::get<1>(signature(general.mesh)));
+  EXPECT_EQ(std::get<2>(signature(local.mesh)), std::get<2>(signature(general.mesh)));
+  BuildReport expected = general.report;
+  expected.skipped_faces = 0;
+  EXPECT_EQ(counts(local.report), counts(expected));
+}
+
+TEST(Build, LocalAndGeneralPathsAgree) {
+  std::mt19937 rng(77);
+  int compared = 0;
+  for (int i = 0; i < 20000 && compared < 300; ++i) {
+    Soup soup = random_soup(rng, false);
+    const BuildResult r = build(soup);
+    // Only soups the local path takes: nothing skipped, repeated or flipped.
+    if (r.report.skipped_faces || r.report.repeated_vertex_faces || r.report.flipped_faces || r.report.unorientable_edges)
+      continue;
+    SCOPED_TRACE("iteration " + std::to_string(i));
+    expect_same_as_general_path(soup);
+    ++compared;
+    if (HasFailure()) break;
+  }
+  EXPECT_GT(compared, 50);
+  expect_same_as_general_path(make_soup(6, {{0, 1, 2}, {1, 0, 3}, {0, 1, 4}, {1, 0, 5}}));
+}
+
 TEST(Build, RandomSoupsAlwaysValidateAndRoundTrip) {
   std::mt19937 rng(20240611);
   std::size_t repaired = 0;
@@ -631,6 +663,7 @@ TEST_P(BuildRealMesh, BuildsValidatesAndRoundTrips) {
   const Soup back = extract(r.mesh);
   const auto t4 = std::chrono::steady_clock::now();
   EXPECT_EQ(back, without_faces(soup, r.maps.skipped_faces));
+  if (soup.n_faces() < 300000) expect_same_as_general_path(soup);
   auto ms = [](auto a, auto b) { return std::chrono::duration<double, std::milli>(b - a).count(); };
   std::cout << "[ timing ] " << GetParam() << ": " << soup.n_vertices() << " vertices, " << soup.n_faces()
             << " faces; read " << ms(t0, t1) << " ms, build " << ms(t1, t2) << " ms, extract " << ms(t3, t4)
