@@ -270,7 +270,8 @@ void real_mesh(const std::string& name) {
   if (!std::filesystem::exists(path)) GTEST_SKIP() << name << " not found";
   Mesh mesh = build(read_mesh(path)).mesh;
   const std::size_t faces = mesh.n_faces();
-  const double area = mesh_statistics(mesh).area;
+  const MeshStatistics stats_before = mesh_statistics(mesh);
+  const double area = stats_before.area;
   const auto start = std::chrono::steady_clock::now();
   const std::clock_t cpu = std::clock();
   DelaunayReport r = make_delaunay(mesh);
@@ -282,7 +283,12 @@ void real_mesh(const std::string& name) {
   EXPECT_EQ(r.after.flippable, 0u);
   EXPECT_LT(r.after.non_delaunay, r.before.non_delaunay);
   EXPECT_EQ(delaunay_census(mesh).flippable, 0u);
-  EXPECT_NEAR(mesh_statistics(mesh).area / area, 1.0, 0.01);
+  const MeshStatistics stats_after = mesh_statistics(mesh);
+  EXPECT_NEAR(stats_after.area / area, 1.0, 0.01);
+  EXPECT_GE(stats_after.mean_min_angle_degrees, stats_before.mean_min_angle_degrees);
+  std::printf("[ figures  ] make_delaunay %s: mean smallest angle %.2f -> %.2f degrees, mean quality %.4f -> %.4f\n",
+              name.c_str(), stats_before.mean_min_angle_degrees, stats_after.mean_min_angle_degrees,
+              stats_before.quality_mean, stats_after.quality_mean);
   std::printf(
       "[ figures  ] make_delaunay %s (%zu faces): %zu flips, non-Delaunay edges %zu -> %zu (features %zu, seams %zu, "
       "blocked %zu, folds %zu), %.3f s wall, %.3f s CPU\n",

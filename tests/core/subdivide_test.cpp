@@ -502,6 +502,48 @@ TEST(Subdivide, CatalogueEntry) {
   EXPECT_EQ(std::get<std::int64_t>(*r.find("faces")), 96);
 }
 
+// The whole pipeline the hosts use: soup with attributes -> build -> subdivide -> extract.
+TEST(Subdivide, RunsThroughTheHostPipelineWithAttributes) {
+  Soup soup;
+  soup.positions = {{{0, 0, 0}}, {{1, 0, 0}}, {{1, 1, 0}}, {{0, 1, 0}},
+                    {{0, 0, 1}}, {{1, 0, 1}}, {{1, 1, 1}}, {{0, 1, 1}}};
+  for (auto f : std::vector<std::vector<std::uint32_t>>{
+           {0, 3, 2, 1}, {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}, {4, 5, 6, 7}})
+    soup.add_face(f);
+  Channel& color = soup.add_channel("color", Domain::vertex, ScalarType::f32, 3);
+  std::memcpy(color.data.data(), soup.positions.data(), color.data.size());
+  Channel& uv = soup.add_channel("uv", Domain::corner, ScalarType::f32, 2);
+  for (std::size_t c = 0; c < soup.n_corners(); ++c) {
+    const float value[2] = {float(c), float(c / 4)};  // every face its own chart
+    std::memcpy(uv.data.data() + c * sizeof value, value, sizeof value);
+  }
+  Channel& material = soup.add_channel("material", Domain::face, ScalarType::i32, 1);
+  for (std::size_t f = 0; f < soup.n_faces(); ++f) material.as<std::int32_t>()[f] = std::int32_t(10 + f);
+
+  const Operation& op = find_operation("subdivide");
+  RunResult r = run_operation(
+      op, soup, resolve_params(op, std::map<std::string, std::string>{{"scheme", "catmull_clark"}}), Progress::none());
+  const Soup& out = r.soup;
+  out.check();
+  EXPECT_EQ(out.n_vertices(), 26u);
+  EXPECT_EQ(out.n_faces(), 24u);
+  const Channel* out_color = out.find("color", Domain::vertex);
+  const Channel* out_uv = out.find("uv", Domain::corner);
+  const Channel* out_material = out.find("material", Domain::face);
+  ASSERT_TRUE(out_color && out_uv && out_material);
+  EXPECT_EQ(out_uv->count(), 96u);
+  for (std::size_t v = 0; v < out.n_vertices(); ++v)
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(out_color->as<float>()[3 * v + k], out.positions[v][k], 1e-6f);
+  std::map<std::int32_t, int> children;
+  for (std::size_t f = 0; f < out.n_faces(); ++f) ++children[out_material->as<std::int32_t>()[f]];
+  for (std::int32_t m = 10; m < 16; ++m) EXPECT_EQ(children[m], 4);
+  // Each child corner's uv is a blend of its parent face's uvs only: v = c / 4 of the parent.
+  for (std::size_t f = 0; f < out.n_faces(); ++f) {
+    const std::int32_t parent = out_material->as<std::int32_t>()[f] - 10;
+    for (std::size_t k = 0; k < 4; ++k) EXPECT_EQ(out_uv->as<float>()[2 * (4 * f + k) + 1], float(parent));
+  }
+}
+
 Mesh load(const std::string& name) {
   const std::string path = std::string(HEDGE_MESH_DIR) + "/" + name;
   if (!std::filesystem::exists(path)) return Mesh();
