@@ -72,16 +72,6 @@ void parallel_ranges(std::size_t n, Fn&& fn) {
   other.join();
 }
 
-// Random reads over big arrays wait for memory; asking a few iterations ahead hides it.
-constexpr std::uint32_t kPrefetch = 16;
-inline void prefetch(const void* p) {
-#if defined(__GNUC__)
-  __builtin_prefetch(p);
-#else
-  (void)p;
-#endif
-}
-
 // Memory for the big temporary arrays: uninitialised (every element is written before it
 // is read), and on transparent huge pages where Linux offers them. In a virtual machine a
 // 4 KiB page fault can cost more than writing the page, and these arrays are written once.
@@ -460,19 +450,49 @@ class Builder {
     }
     Scratch<std::uint32_t> halfedge_of_corner = std::move(list).reuse_as<std::uint32_t>(nc_);
 
-    // Edges: a glued pair shares one, in the order of its first corner.
+    // Edges: a glued pair shares one, numbered in the order of its first corner. Each half
+    // of the faces numbers its own edges on its own thread; then the second half's numbers
+    // are shifted by the first half's count, and its half-edges whose twin lies in the
+    // first half (kInv until then) are filled in.
     std::uint32_t* H = halfedge_of_corner.get();
-    std::uint32_t ne = 0;
-    for (std::size_t f = 0; f < nf_; ++f) {
-      std::uint32_t prev = soff_[f + 1] - 1;
-      for (std::uint32_t m = soff_[f]; m < soff_[f + 1]; ++m) {
-        const std::uint32_t t = out_twin[prev];
-        // The twin's half-edge is a random read; fetch the one a few corners ahead.
-        if (m + kPrefetch < nc_ && out_twin[m + kPrefetch] < m) prefetch(H + out_twin[m + kPrefetch]);
-        H[m] = (t == kInv || t > m) ? 2 * ne++ : H[t] ^ 1u;
-        prev = m;
+    std::uint32_t edges_in[2] = {0, 0};
+    auto number = [&](std::size_t fbegin, std::size_t fend, int part) {
+      const std::uint32_t first = soff_[fbegin];
+      if (first < nc_) H[first] = 0;  // read (harmlessly) before it is written
+      std::uint32_t ne = 0;
+      for (std::size_t f = fbegin; f < fend; ++f) {
+        std::uint32_t prev = soff_[f + 1] - 1;
+        for (std::uint32_t m = soff_[f]; m < soff_[f + 1]; ++m) {
+          // A new edge unless the twin came first (kInv, a boundary, is above every m).
+          // Branch-free: which case it is is a coin toss.
+          const std::uint32_t t = out_twin[prev];
+          const bool fresh = t > m, elsewhere = !fresh && t < first;
+          const std::uint32_t twin_half = H[fresh || elsewhere ? first : t] ^ 1u;
+          H[m] = fresh ? 2 * ne : elsewhere ? kInv : twin_half;
+          ne += fresh;
+          prev = m;
+        }
       }
+      edges_in[part] = ne;
+    };
+    if (fmid_ < nf_) {
+      std::thread other([&] { number(fmid_, nf_, 1); });
+      number(0, fmid_, 0);
+      other.join();
+      const std::uint32_t shift = 2 * edges_in[0];
+      parallel_ranges(nf_ - fmid_, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t f = fmid_ + begin; f < fmid_ + end; ++f) {
+          std::uint32_t prev = soff_[f + 1] - 1;
+          for (std::uint32_t m = soff_[f]; m < soff_[f + 1]; ++m) {
+            H[m] = H[m] == kInv ? H[out_twin[prev]] ^ 1u : H[m] + shift;
+            prev = m;
+          }
+        }
+      });
+    } else {
+      number(0, nf_, 0);
     }
+    const std::uint32_t ne = edges_in[0] + edges_in[1];
     PHASE("edges");
 
     Mesh& mesh = result_.mesh;
