@@ -91,13 +91,23 @@ const char* collapse_refusal(const Mesh& m, Halfedge h) {
       return "the triangle on its right has its two other edges on the boundary";
   }
   if (vl.is_valid() && vl == vr) return "its two triangles share their third corner";
+  // A hole of three (or two) edges would shrink below a triangle.
+  for (Halfedge s : {h, o})
+    if (!m.face(s).is_valid() && (m.next(m.next(s)) == s || m.next(m.next(m.next(s))) == s))
+      return "it lies on a hole of three edges";
   if (!m.is_boundary(Mesh::edge(h)) && m.is_boundary(v0) && m.is_boundary(v1))
     return "it is an interior edge joining two boundary vertices (the surface would be pinched)";
 
-  // Common neighbours other than vl and vr would become doubled edges.
-  for (Vertex v : m.vertices(v0))
-    if (v != v1 && v != vl && v != vr && m.find_halfedge(v, v1).is_valid())
+  // Common neighbours other than vl and vr would become doubled edges; a second edge
+  // between v0 and v1 (build() keeps those where the input has them) would become a loop.
+  int edges_to_v1 = 0;
+  for (Vertex v : m.vertices(v0)) {
+    if (v == v1) {
+      if (++edges_to_v1 > 1) return "a second edge joins its end vertices";
+    } else if (v != vl && v != vr && m.find_halfedge(v, v1).is_valid()) {
       return "its end vertices have a common neighbour besides the triangles' corners (link condition)";
+    }
+  }
 
   // Triangles (v0, vl, vr) and (v1, vl, vr) would become the same triangle twice.
   if (vl.is_valid() && vr.is_valid()) {

@@ -232,6 +232,40 @@ Mesh quad_pillow() {
   return m;
 }
 
+// A closed mesh from faces whose edges are named: both sides of an edge carry its name, so
+// two edges may join the same two vertices. add_face never makes such doubled edges, but
+// build() keeps them where the input has them. faces[f][i] = (corner i, name of the edge
+// from corner i to corner i+1).
+Mesh closed_mesh_with_named_edges(int n_vertices, const std::vector<std::vector<std::pair<Index, int>>>& faces) {
+  Mesh m;
+  for (int i = 0; i < n_vertices; ++i) m.add_vertex(pt(float(i), float(i * i % 3)));
+  std::map<int, Halfedge> named;
+  for (const auto& corners : faces) {
+    Face f = m.new_face();
+    std::vector<Halfedge> loop;
+    for (std::size_t i = 0; i < corners.size(); ++i) {
+      Vertex a(corners[i].first), b(corners[(i + 1) % corners.size()].first);
+      auto it = named.find(corners[i].second);
+      Halfedge h = it == named.end() ? m.new_edge(a, b) : Mesh::opposite(it->second);
+      named[corners[i].second] = h;
+      m.set_face(h, f);
+      m.set_halfedge(a, h);
+      loop.push_back(h);
+    }
+    for (std::size_t i = 0; i < loop.size(); ++i) m.set_next(loop[i], loop[(i + 1) % loop.size()]);
+    m.set_halfedge(f, loop.back());
+  }
+  return m;
+}
+
+// A sphere of four triangles in which two edges join vertices 0 and 2.
+Mesh lunes() {
+  return closed_mesh_with_named_edges(4, {{{0, 'a'}, {1, 'b'}, {2, 'X'}},
+                                         {{0, 'X'}, {2, 'c'}, {3, 'd'}},
+                                         {{0, 'd'}, {3, 'c'}, {2, 'Y'}},
+                                         {{0, 'Y'}, {2, 'b'}, {1, 'a'}}});
+}
+
 Point midpoint(const Mesh& m, Edge e) { return (m.position(m.vertex(e, 0)) + m.position(m.vertex(e, 1))) * 0.5f; }
 
 // ---- adding vertices and faces -----------------------------------------------------------
@@ -995,6 +1029,15 @@ TEST(Euler, CollapseRefusals) {
   refused(qp, diag);
   refused(qp, qp.opposite(diag));
   refused(qp, Halfedge(12345));
+  // Two edges join vertices 0 and 2 (a sphere of four triangles, two lunes): collapsing one
+  // would turn the other into a loop.
+  Mesh twice = lunes();
+  ASSERT_VALID(twice);
+  ASSERT_EQ(twice.n_edges(), 6u);
+  for (Halfedge h : twice.halfedges())
+    if ((twice.from_vertex(h) == Vertex(0) && twice.to_vertex(h) == Vertex(2)) ||
+        (twice.from_vertex(h) == Vertex(2) && twice.to_vertex(h) == Vertex(0)))
+      refused(twice, h);
 }
 
 TEST(Euler, CollapsePolygons) {
@@ -1144,6 +1187,7 @@ class Stress {
     m_.halfedge_property<float>("uv");
     m_.edge_property<int>("crease");
     m_.vertex_property<float>("weight");
+    doubled_ = doubled_edges();
   }
 
   //! Runs n operations; returns false (with a message) at the first broken invariant.
@@ -1161,8 +1205,10 @@ class Stress {
       ++tally_[what];
       Validation v = validate(m_);
       if (!v) return ::testing::AssertionFailure() << "step " << i << " after " << what << ": " << v.message;
-      if (std::string d = doubled_edge(); !d.empty())
-        return ::testing::AssertionFailure() << "step " << i << " after " << what << ": " << d;
+      if (const std::size_t d = doubled_edges(); d > doubled_)
+        return ::testing::AssertionFailure() << "step " << i << " after " << what << ": a second edge joins two vertices";
+      else
+        doubled_ = d;
       if (m_.n_faces() == 0) return ::testing::AssertionFailure() << "step " << i << ": the mesh vanished";
     }
     return ::testing::AssertionSuccess();
@@ -1248,18 +1294,20 @@ class Stress {
     return std::string("!") + op + " did not refuse";
   }
 
-  // validate() does not look for two edges joining the same vertices; no operation may make one.
-  std::string doubled_edge() {
+  // validate() does not look for two edges joining the same vertices (build() keeps them
+  // where the input has them); no operation may make a new one.
+  std::size_t doubled_edges() {
+    std::size_t n = 0;
     for (Vertex x : m_.vertices()) {
       ring_.clear();
       for (Vertex w : m_.vertices(x)) ring_.push_back(w);
       std::sort(ring_.begin(), ring_.end());
-      auto d = std::adjacent_find(ring_.begin(), ring_.end());
-      if (d != ring_.end()) return "vertices " + std::to_string(x.idx()) + " and " + std::to_string(d->idx()) + " are joined twice";
+      for (std::size_t i = 1; i < ring_.size(); ++i) n += ring_[i] == ring_[i - 1];
     }
-    return "";
+    return n;
   }
   std::vector<Vertex> ring_;
+  std::size_t doubled_ = 0;
 
   // delete_face (pmp semantics) leaves a boundary vertex with a second gap when f touches
   // it away from its existing gap; the stress run only deletes faces that keep one fan.
@@ -1510,7 +1558,8 @@ TEST(EulerStress, RandomOperationsKeepEveryInvariant) {
   cases.push_back({"closed icosahedron", refined(icosahedron(), 1), 60, 300, 30000});
   cases.push_back({"closed cube of quads", refined(cube(), 1), 20, 200, 25000});
   cases.push_back({"open quad grid", quad_grid(8, 8), 30, 200, 25000});
-  cases.push_back({"triangle grid with holes", std::move(holes), 80, 300, 25000});
+  cases.push_back({"triangle grid with holes", std::move(holes), 80, 300, 20000});
+  cases.push_back({"closed lunes with a doubled edge", lunes(), 10, 150, 5000});
   std::size_t total = 0;
   // Fixed for reproducible runs; HEDGE_STRESS_SEED explores other sequences by hand.
   std::uint32_t seed = 20240601;
