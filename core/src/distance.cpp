@@ -81,7 +81,6 @@ namespace {
 constexpr Index kLeafSize = 4;
 constexpr int kBins = 12;
 
-
 struct Box {
   float lo[3] = {std::numeric_limits<float>::max(), std::numeric_limits<float>::max(),
                  std::numeric_limits<float>::max()};
@@ -176,8 +175,8 @@ struct Builder {
       child_box[side].add(bins[b].box);
       child_cbox[side].add(bins[b].cbox);
     }
-    auto it = std::partition(refs.begin() + begin, refs.begin() + end,
-                             [&](const Ref& r) { return bin_of(r) < best_split; });
+    auto it =
+        std::partition(refs.begin() + begin, refs.begin() + end, [&](const Ref& r) { return bin_of(r) < best_split; });
     return static_cast<Index>(it - refs.begin());
   }
 
@@ -483,8 +482,7 @@ struct Sampler {
     }
   }
 
-  void sample_triangle(const Vec3d& a, const Vec3d& b, const Vec3d& c, Random& rng, Index& hint,
-                       Partial& r) const {
+  void sample_triangle(const Vec3d& a, const Vec3d& b, const Vec3d& c, Random& rng, Index& hint, Partial& r) const {
     double area = 0.5 * norm(cross(b - a, c - a));
     double expected = area * density;
     auto n = static_cast<std::size_t>(std::floor(expected + rng.uniform()));
@@ -567,8 +565,7 @@ OneSidedDistance one_sided_distance(const Mesh& from, const TriangleTree& to, co
   if (to.empty()) throw Error("distance: the surface to measure against has no faces");
   Sampler sampler{from, to, options};
   double area = surface_area(from);
-  if (area > 0 && options.sample_density > 0)
-    sampler.density = options.sample_density * double(from.n_faces()) / area;
+  if (area > 0 && options.sample_density > 0) sampler.density = options.sample_density * double(from.n_faces()) / area;
 
   struct Block {
     Kind kind;

@@ -23,8 +23,7 @@ Mesh mesh_of(const Soup& soup) { return build(soup).mesh; }
 Soup grid_soup(int n, double size, double z) {
   Soup s;
   for (int j = 0; j <= n; ++j)
-    for (int i = 0; i <= n; ++i)
-      s.positions.push_back(Point{{float(size * i / n), float(size * j / n), float(z)}});
+    for (int i = 0; i <= n; ++i) s.positions.push_back(Point{{float(size * i / n), float(size * j / n), float(z)}});
   auto id = [n](int i, int j) { return std::uint32_t(j * (n + 1) + i); };
   for (int j = 0; j < n; ++j)
     for (int i = 0; i < n; ++i) {
@@ -59,9 +58,8 @@ Soup sphere_soup(int rings, int segments, double r, Vec3d c) {
 double brute_force(const Vec3d& p, const std::vector<Point>& pos, const std::vector<std::array<Index, 3>>& tris) {
   double best = std::numeric_limits<double>::infinity();
   for (const auto& t : tris)
-    best = std::min(best, closest_point_on_triangle(p, to_double(pos[t[0]]), to_double(pos[t[1]]),
-                                                    to_double(pos[t[2]]))
-                              .distance);
+    best = std::min(
+        best, closest_point_on_triangle(p, to_double(pos[t[0]]), to_double(pos[t[1]]), to_double(pos[t[2]])).distance);
   return best;
 }
 
@@ -256,10 +254,11 @@ TEST(Distance, RealMeshFigures) {
     auto t3 = std::chrono::steady_clock::now();
     EXPECT_LT(self.max, 1e-9 * norm(tree.box_max() - tree.box_min()));
     auto ms = [](auto a, auto b) { return std::chrono::duration<double, std::milli>(b - a).count(); };
-    std::printf("[ figures  ] %s: %zu triangles, tree %.1f ms (%.1f MB), %zu queries %.1f ms (%.2f us each), "
-                "self-Hausdorff %zu+%zu samples %.1f ms\n",
-                name, tree.n_triangles(), ms(t0, t1), double(tree.heap_bytes()) / 1e6, queries, ms(t1, t2),
-                1e3 * ms(t1, t2) / double(queries), self.a_to_b.samples, self.b_to_a.samples, ms(t2, t3));
+    std::printf(
+        "[ figures  ] %s: %zu triangles, tree %.1f ms (%.1f MB), %zu queries %.1f ms (%.2f us each), "
+        "self-Hausdorff %zu+%zu samples %.1f ms\n",
+        name, tree.n_triangles(), ms(t0, t1), double(tree.heap_bytes()) / 1e6, queries, ms(t1, t2),
+        1e3 * ms(t1, t2) / double(queries), self.a_to_b.samples, self.b_to_a.samples, ms(t2, t3));
   }
 }
 

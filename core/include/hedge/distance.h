@@ -44,9 +44,7 @@ class TriangleTree {
   std::size_t n_triangles() const { return triangles_.size(); }
   bool empty() const { return triangles_.empty(); }
   //! The mesh face a triangle came from (mesh constructor), else the triangle itself.
-  Face face(Index triangle) const {
-    return faces_.empty() ? Face(triangle) : faces_[triangle];
-  }
+  Face face(Index triangle) const { return faces_.empty() ? Face(triangle) : faces_[triangle]; }
   //! The triangle's corners, in the order given.
   std::array<Vec3d, 3> corners(Index triangle) const;
   //! Bounding box of all triangles.

@@ -7,6 +7,7 @@
   X(subdivide)          \
   X(smooth)             \
   X(make_delaunay)      \
+  X(remesh)             \
   X(fill_holes)         \
   X(repair)             \
   X(triangulate)
