@@ -4,11 +4,13 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <map>
 #include <numbers>
 #include <set>
 #include <vector>
@@ -268,10 +270,7 @@ TEST(FillHoles, FairedPatchFollowsAParaboloid) {
       }
     std::printf("[ fill_holes ] paraboloid, hole of 8 x 8 (depth 0.8), %s weights: worst height error %.4f\n",
                 weights == FairingWeights::cotangent ? "cotangent" : "uniform", worst);
-    if (weights == FairingWeights::cotangent)
-      EXPECT_LT(worst, 0.02);
-    else
-      EXPECT_LT(worst, 0.1);
+    EXPECT_LT(worst, weights == FairingWeights::cotangent ? 0.02 : 0.1);
   }
 }
 
@@ -371,6 +370,52 @@ TEST(FillHoles, QuadMeshHole) {
       const Point& p = mesh.position(v);
       EXPECT_NEAR(p[2], ((p[0] - 6) * (p[0] - 6) + (p[1] - 6) * (p[1] - 6)) / 20, 0.1) << v.idx();
     }
+}
+
+TEST(FillHoles, PatchTurnsWithFlippedNeighbours) {
+  // The host's faces left of x = 4 are listed backwards; build() flips them, extract()
+  // turns them back. The patch must come out turned like the faces it borders.
+  Soup soup = grid_with_hole(12, 3);
+  const auto offset = soup.face_offsets();
+  const std::size_t original_faces = soup.n_faces();
+  for (std::size_t f = 0; f < original_faces; ++f)
+    if (soup.positions[soup.corners[offset[f]]][0] < 4)
+      std::reverse(soup.corners.begin() + std::ptrdiff_t(offset[f]),
+                   soup.corners.begin() + std::ptrdiff_t(offset[f + 1]));
+  BuildResult built = build(soup);
+  ASSERT_GT(built.report.flipped_faces, 0u);
+  FillHolesOptions options;
+  options.max_hole_edges = 30;
+  Mesh mesh = std::move(built.mesh);
+  ASSERT_EQ(fill_holes(mesh, options).holes_filled, 1u);
+  ASSERT_VALID(mesh);
+  Soup out = extract(mesh);
+  // Directed edges of the old faces; a patch face sharing an edge must run it backwards.
+  std::map<std::pair<std::uint32_t, std::uint32_t>, std::size_t> directed;
+  const auto out_offset = out.face_offsets();
+  auto for_edges = [&](std::size_t f, auto fn) {
+    const std::size_t n = out.face_sizes[f];
+    for (std::size_t i = 0; i < n; ++i) fn(out.corners[out_offset[f] + i], out.corners[out_offset[f] + (i + 1) % n]);
+  };
+  for (std::size_t f = 0; f < original_faces; ++f)
+    for_edges(f, [&](std::uint32_t a, std::uint32_t b) { directed[{a, b}] = f; });
+  // Where the border passes from turned to unturned faces, a patch triangle touching both
+  // kinds cannot agree with both: it must agree with one.
+  std::size_t shared = 0, conflicts = 0;
+  for (std::size_t f = original_faces; f < out.n_faces(); ++f) {
+    std::size_t agree = 0, disagree = 0;
+    for_edges(f, [&](std::uint32_t a, std::uint32_t b) {
+      disagree += directed.count({a, b});
+      agree += directed.count({b, a});
+    });
+    shared += agree;
+    conflicts += disagree;
+    if (disagree) {
+      EXPECT_GT(agree, 0u) << "patch face " << f << " is turned against all its neighbours";
+    }
+  }
+  EXPECT_LE(conflicts, 4u);
+  EXPECT_GT(shared, 10u);
 }
 
 TEST(FillHoles, ExistingDiagonalIsNotDoubled) {

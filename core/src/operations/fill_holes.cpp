@@ -640,9 +640,13 @@ bool HoleFiller::solve_fairing(bool cotangent) {
 
 // Face attributes come from the nearest face across the border (breadth-first through the
 // patch), corner attributes from each vertex's corner value, and internal bookkeeping
-// takes its defaults.
+// takes its defaults (but for the orientation flag).
 void HoleFiller::finish_attributes() {
   // in_patch_ is 1 for a patch face waiting for its attributes, 2 once it has them.
+  // build()'s "hedge:flipped" is the exception to the defaults: extract() turns flipped
+  // faces back as the host had them, and the patch must turn with its neighbours to stay
+  // consistently oriented in the host's eyes.
+  TypedArray<bool>* flipped = mesh_.face_properties().get<bool>("hedge:flipped");
   std::vector<std::pair<Face, Face>> queue;  // (patch face, face to copy from)
   std::size_t head = 0;
   for (Halfedge b : loop_) queue.emplace_back(mesh_.face(b), mesh_.face(mesh_.opposite(b)));
@@ -652,6 +656,7 @@ void HoleFiller::finish_attributes() {
     if (in_patch_[f.idx()] != 1) continue;
     in_patch_[f.idx()] = 2;  // attributes set
     copy_attributes(mesh_.face_properties(), from.idx(), f.idx());
+    if (flipped) flipped->vector()[f.idx()] = bool(flipped->vector()[from.idx()]);
     for (Halfedge h : mesh_.halfedges(f)) {
       Face g = mesh_.face(mesh_.opposite(h));
       if (g.is_valid() && g.idx() < in_patch_.size() && in_patch_[g.idx()] == 1) queue.emplace_back(g, from);
