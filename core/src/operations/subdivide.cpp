@@ -104,6 +104,14 @@ struct Target {
   bool internal = false;
 };
 
+//! std::vector<bool> packs elements into shared words: such arrays must be written by one
+//! thread only.
+unsigned threads_for(const std::vector<Target>& all, unsigned threads) {
+  for (const Target& t : all)
+    if (t.array->type() == typeid(bool)) return 1;
+  return threads;
+}
+
 std::vector<Target> targets(PropertyContainer& c) {
   std::vector<Target> out;
   for (std::size_t i = 0; i < c.count(); ++i) {
@@ -214,6 +222,7 @@ void refine_vertices(const Mesh& m, Mesh& out, const VertexRule& rule, unsigned 
   if (props.count()) {
     props.resize(std::size_t(2) * V + N);
     std::vector<Target> all = targets(props);
+    threads = threads_for(all, threads);
     for (auto [b, e] : rule.phases)
       parallel_for(e - b, threads, [&](std::size_t lo, std::size_t hi) {
         Stencil s;
@@ -260,7 +269,7 @@ void refine_corners(const Mesh& m, Mesh& out, std::size_t extra, const std::vect
     std::vector<Target> blended;
     for (const Target& t : all)
       if (!t.internal) blended.push_back(t);
-    if (!blended.empty()) fill(blended, threads);
+    if (!blended.empty()) fill(blended, threads_for(blended, threads));
     props.permute(map);
   } else {
     props.resize(out.halfedges_size());
