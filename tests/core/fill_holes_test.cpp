@@ -185,6 +185,7 @@ TEST(FillHoles, MaxHoleEdgesLeavesLargeHolesOpen) {
   ASSERT_VALID(mesh);
   EXPECT_EQ(r.holes_filled, 1u);
   EXPECT_EQ(r.holes_skipped, 1u);
+  EXPECT_EQ(r.holes_too_large, 1u);
   EXPECT_EQ(r.largest_skipped_edges, large);
   EXPECT_EQ(loop_lengths(mesh), std::vector<std::size_t>{large});
   ASSERT_FALSE(r.messages.empty());
@@ -446,6 +447,7 @@ TEST(FillHoles, LoneTriangleIsNotDoubled) {
   EXPECT_EQ(r.holes_found, 1u);
   EXPECT_EQ(r.holes_filled, 0u);
   EXPECT_EQ(r.holes_skipped, 1u);
+  EXPECT_EQ(r.lone_faces, 1u);
   EXPECT_EQ(mesh.n_faces(), 1u);
 }
 
@@ -564,6 +566,7 @@ TEST(FillHoles, OperationRunsFromTheCatalogue) {
   EXPECT_EQ(std::get<std::int64_t>(*run.report.find("holes_found")), 2);
   EXPECT_EQ(std::get<std::int64_t>(*run.report.find("holes_filled")), 1);
   EXPECT_EQ(std::get<std::int64_t>(*run.report.find("holes_skipped")), 1);
+  EXPECT_EQ(std::get<std::int64_t>(*run.report.find("holes_too_large")), 1);
   BuildResult again = build(run.soup);
   EXPECT_FALSE(again.report.repaired());
   EXPECT_EQ(loop_lengths(again.mesh).size(), 1u);

@@ -44,7 +44,10 @@ struct FillHolesOptions {
 struct FillHolesReport {
   std::size_t holes_found = 0;  //!< boundary loops before filling
   std::size_t holes_filled = 0;
-  std::size_t holes_skipped = 0;  //!< more than max_hole_edges edges, or a lone polygon's border
+  std::size_t holes_skipped = 0;    //!< left open: the three kinds below
+  std::size_t holes_too_large = 0;  //!< more than max_hole_edges edges
+  std::size_t lone_faces = 0;       //!< the border of a face with no neighbour (filling would double it)
+  std::size_t slits = 0;            //!< loops of two edges joining the same two vertices (no triangle fits)
   std::size_t largest_skipped_edges = 0;
   std::size_t triangles_added = 0;
   std::size_t vertices_added = 0;

@@ -704,16 +704,14 @@ FillHolesReport fill_holes(Mesh& input, const FillHolesOptions& options, Progres
 
   std::vector<Hole> to_fill;
   std::size_t total_edges = 0;
-  std::size_t lone_polygons = 0, slits = 0;
   for (const Hole& hole : holes) {
     if (options.max_hole_edges && hole.edges > options.max_hole_edges) {
-      ++report.holes_skipped;
+      ++report.holes_too_large;
       report.largest_skipped_edges = std::max(report.largest_skipped_edges, hole.edges);
       continue;
     }
     if (hole.edges < 3) {  // two edges joining the same two vertices: no triangle fits
-      ++report.holes_skipped;
-      ++slits;
+      ++report.slits;
       continue;
     }
     // The border of a lone polygon: filling it would only add the same face backwards.
@@ -722,21 +720,23 @@ FillHolesReport fill_holes(Mesh& input, const FillHolesOptions& options, Progres
     for (Halfedge b : input.loop(hole.start))
       if (input.face(Mesh::opposite(b)) != only) lone = false;
     if (lone) {
-      ++report.holes_skipped;
-      ++lone_polygons;
+      ++report.lone_faces;
       continue;
     }
     to_fill.push_back(hole);
     total_edges += hole.edges;
   }
-  if (options.max_hole_edges && report.holes_skipped > lone_polygons + slits)
-    report.messages.push_back(std::to_string(report.holes_skipped - lone_polygons - slits) + " holes with more than " +
+  report.holes_skipped = report.holes_too_large + report.lone_faces + report.slits;
+  if (report.holes_too_large)
+    report.messages.push_back(std::to_string(report.holes_too_large) + " holes with more than " +
                               std::to_string(options.max_hole_edges) + " edges left open (the largest has " +
                               std::to_string(report.largest_skipped_edges) + ")");
-  if (lone_polygons)
-    report.messages.push_back(std::to_string(lone_polygons) +
-                              " single faces not backed by a second face (their border is their only hole)");
-  if (slits) report.messages.push_back(std::to_string(slits) + " holes of two edges left open (no triangle fits them)");
+  if (report.lone_faces)
+    report.messages.push_back(std::to_string(report.lone_faces) +
+                              " single faces with no neighbour left open (filling would only double them)");
+  if (report.slits)
+    report.messages.push_back(std::to_string(report.slits) +
+                              " holes of two edges left open (no triangle fits them; repair removes them)");
   if (to_fill.empty()) return report;
 
   // Work on a copy so that a failure or a cancel leaves the input as it was.
@@ -799,6 +799,9 @@ Operation fill_holes_operation() {
     report.add("holes_found", count(r.holes_found));
     report.add("holes_filled", count(r.holes_filled));
     report.add("holes_skipped", count(r.holes_skipped));
+    report.add("holes_too_large", count(r.holes_too_large));
+    report.add("lone_faces_left_open", count(r.lone_faces));
+    report.add("two_edge_slits_left_open", count(r.slits));
     report.add("triangles_added", count(r.triangles_added));
     report.add("vertices_added", count(r.vertices_added));
     report.messages = r.messages;
