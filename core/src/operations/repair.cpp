@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <limits>
 #include <numeric>
 #include <utility>
@@ -20,6 +21,12 @@ namespace {
 
 std::string plural(std::size_t n, const char* one, const char* many) {
   return std::to_string(n) + " " + (n == 1 ? one : many);
+}
+
+std::string number(double x) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%g", x);
+  return buffer;
 }
 
 // ---- provenance ---------------------------------------------------------------------------
@@ -467,8 +474,7 @@ BuildRepairs build_repairs(const Mesh& mesh) {
 
 RepairReport repair(Mesh& mesh, const RepairOptions& options, Progress& progress) {
   if (!std::isfinite(options.weld_distance) || options.weld_distance < 0)
-    throw Error("repair: weld_distance must be a finite number of at least 0, got " +
-                std::to_string(options.weld_distance));
+    throw Error("repair: weld_distance must be a finite number of at least 0, got " + number(options.weld_distance));
   RepairReport report;
   progress.update(0, "reading what building repaired");
   const BuildRepairs input = build_repairs(mesh);
@@ -550,8 +556,8 @@ RepairReport repair(Mesh& mesh, const RepairOptions& options, Progress& progress
   work.garbage_collect();
 
   say(report, report.vertices_welded,
-      "welded " + plural(report.vertices_welded, "vertex", "vertices") + " into a neighbour closer than " +
-          std::to_string(options.weld_distance));
+      "welded " + plural(report.vertices_welded, "vertex", "vertices") + " into a neighbour at most " +
+          number(options.weld_distance) + " away");
   say(report, report.duplicate_faces_removed,
       "removed " + plural(report.duplicate_faces_removed, "duplicate face", "duplicate faces"));
   say(report, report.non_manifold_edges_split,
