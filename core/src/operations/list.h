@@ -4,6 +4,7 @@
 
 #define HEDGE_OPERATIONS(X) \
   X(report)             \
+  X(decimate)           \
   X(subdivide)          \
   X(smooth)             \
   X(make_delaunay)      \

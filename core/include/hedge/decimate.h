@@ -1,0 +1,69 @@
+// Decimation: quadric error metric edge collapse (Garland & Heckbert 1997), carrying every
+// vertex and per-corner attribute, keeping boundaries and UV seams, refusing fold-overs.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+#include "hedge/catalogue.h"
+#include "hedge/mesh.h"
+#include "hedge/progress.h"
+
+namespace hedge {
+
+struct DecimateOptions {
+  //! Number of triangles to reach; 0 means "use target_ratio".
+  std::size_t target_faces = 0;
+  //! Fraction of the triangles to keep (0 to 1) when target_faces is 0.
+  double target_ratio = 0.5;
+  //! Stop before any collapse whose error exceeds this fraction of the bounding-box
+  //! diagonal; 0 = no limit. The error of a collapse is the area-weighted RMS distance of
+  //! the new vertex to the planes of the original triangles merged into it.
+  double max_error = 0;
+  //! Boundary vertices never move; boundary edges only collapse along the boundary, into
+  //! one of their two end points; boundary loops keep their number.
+  bool preserve_boundary = true;
+  //! Per-corner attributes (UVs, corner normals and colours) stay continuous: a vertex on
+  //! a seam only collapses along the seam, seam junctions stay, and the merged corners
+  //! ("wedges") are interpolated consistently on both sides.
+  bool preserve_uv_seams = true;
+  //! Refuse collapses that turn a triangle by more than max_normal_change_degrees, or
+  //! leave it degenerate.
+  bool prevent_flips = true;
+  //! Largest rotation of a triangle's normal one collapse may cause (with prevent_flips).
+  double max_normal_change_degrees = 90;
+  //! Refuse collapses that create a triangle of quality (2 r_in / r_out) below this, unless
+  //! the triangles they replace were already worse.
+  double min_quality = 0;
+};
+
+struct DecimateReport {
+  std::size_t faces_before = 0, faces_after = 0;
+  std::size_t vertices_before = 0, vertices_after = 0;
+  std::size_t target_faces = 0;
+  std::size_t triangulated_faces = 0;  //!< polygons split into triangles first
+  std::size_t collapses = 0;
+  //! Largest error of a collapse done, as a fraction of the bounding-box diagonal.
+  double max_error = 0;
+  //! Why it stopped: "target reached", "max_error reached", "no legal collapse left",
+  //! "target is odd on a closed surface" (stopped one face above it), "nothing to do".
+  std::string stopped_by;
+};
+
+//! Simplifies a triangle mesh to options.target_faces triangles (or target_ratio of them)
+//! by collapsing the edge of least quadric error first (Garland & Heckbert, "Surface
+//! Simplification Using Quadric Error Metrics", SIGGRAPH 1997), placing the new vertex at
+//! the quadric's minimum (over the edge when that is singular). Polygons are triangulated
+//! first. Vertex properties are interpolated at the new vertex; per-corner properties are
+//! interpolated per wedge (Hoppe 1999), so UV charts stay continuous. Hits the target
+//! exactly when the topology allows it: an interior collapse removes two triangles, a
+//! boundary one removes one, so on closed surfaces an odd target stops one triangle above.
+//! Throws Error on bad options, leaving the mesh untouched; when cancelled through
+//! `progress` the mesh is restored as it was.
+DecimateReport decimate(Mesh& mesh, const DecimateOptions& options, Progress& progress = Progress::none());
+
+//! The catalogue entry.
+Operation decimate_operation();
+
+}  // namespace hedge

@@ -1,0 +1,990 @@
+// Quadric error metric decimation (Garland & Heckbert 1997) with per-wedge interpolation of
+// corner attributes (Hoppe 1999): the algorithm of decimate.h and its catalogue entry.
+#include "hedge/decimate.h"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <numbers>
+#include <optional>
+#include <vector>
+
+#include "hedge/error.h"
+#include "hedge/report.h"
+#ifdef HEDGE_DECIMATE_DEBUG
+#include <cstdio>
+#include "hedge/validate.h"
+#endif
+
+namespace hedge {
+namespace {
+
+// The squared distance to a set of weighted planes, sum of w (n.u + s)^2, as u^T A u +
+// 2 g.u + k in coordinates u relative to an origin (the vertex it belongs to). Relative to
+// the vertex, g and k stay as small as the errors they measure, so a vertex can store its
+// quadric in floats (PackedQuadric) without losing them to cancellation; all arithmetic
+// is in doubles.
+struct Quadric {
+  double a00 = 0, a01 = 0, a02 = 0, a11 = 0, a12 = 0, a22 = 0;  // A
+  double g0 = 0, g1 = 0, g2 = 0, k = 0;
+  double weight = 0;  // sum of the plane weights: value / weight is a mean squared distance
+
+  //! Plane n.u + s = 0 (n unit), weight w.
+  void add_plane(const Vec3d& n, double s, double w) {
+    a00 += w * n[0] * n[0], a01 += w * n[0] * n[1], a02 += w * n[0] * n[2];
+    a11 += w * n[1] * n[1], a12 += w * n[1] * n[2], a22 += w * n[2] * n[2];
+    g0 += w * n[0] * s, g1 += w * n[1] * s, g2 += w * n[2] * s;
+    k += w * s * s;
+    weight += w;
+  }
+  Quadric& operator+=(const Quadric& q) {
+    a00 += q.a00, a01 += q.a01, a02 += q.a02, a11 += q.a11, a12 += q.a12, a22 += q.a22;
+    g0 += q.g0, g1 += q.g1, g2 += q.g2, k += q.k, weight += q.weight;
+    return *this;
+  }
+  friend Quadric operator+(Quadric a, const Quadric& b) { return a += b; }
+
+  Vec3d times(const Vec3d& u) const {
+    return {{a00 * u[0] + a01 * u[1] + a02 * u[2], a01 * u[0] + a11 * u[1] + a12 * u[2],
+             a02 * u[0] + a12 * u[1] + a22 * u[2]}};
+  }
+  Vec3d linear() const { return {{g0, g1, g2}}; }
+  double value(const Vec3d& u) const { return dot(u, times(u)) + 2 * dot(u, linear()) + k; }
+  double operator()(const Vec3d& u) const { return std::max(0.0, value(u)); }
+  //! The same quadric about the origin moved by delta.
+  Quadric shifted(const Vec3d& delta) const {
+    Quadric q = *this;
+    const Vec3d ad = times(delta);
+    q.g0 += ad[0], q.g1 += ad[1], q.g2 += ad[2];
+    q.k = dot(delta, ad) + 2 * dot(delta, linear()) + k;
+    return q;
+  }
+
+  // The minimum, when the 3x3 part is well conditioned. The test det > eps tr^3 is
+  // invariant under rotation and scale and keeps the smallest eigenvalue above eps tr.
+  bool minimum(Vec3d& u) const {
+    const double c00 = a11 * a22 - a12 * a12, c01 = a02 * a12 - a01 * a22, c02 = a01 * a12 - a02 * a11;
+    const double c11 = a00 * a22 - a02 * a02, c12 = a01 * a02 - a00 * a12, c22 = a00 * a11 - a01 * a01;
+    const double det = a00 * c00 + a01 * c01 + a02 * c02;
+    const double tr = a00 + a11 + a22;
+    if (!(det > 1e-9 * tr * tr * tr)) return false;
+    const double inv = -1.0 / det;
+    u = {{(c00 * g0 + c01 * g1 + c02 * g2) * inv, (c01 * g0 + c11 * g1 + c12 * g2) * inv,
+          (c02 * g0 + c12 * g1 + c22 * g2) * inv}};
+    return true;
+  }
+};
+
+// A quadric about its vertex, in 44 bytes.
+struct PackedQuadric {
+  float a00 = 0, a01 = 0, a02 = 0, a11 = 0, a12 = 0, a22 = 0, g0 = 0, g1 = 0, g2 = 0, k = 0, weight = 0;
+  Quadric unpack() const { return {a00, a01, a02, a11, a12, a22, g0, g1, g2, k, weight}; }
+  void store(const Quadric& q) {
+    a00 = float(q.a00), a01 = float(q.a01), a02 = float(q.a02), a11 = float(q.a11), a12 = float(q.a12);
+    a22 = float(q.a22), g0 = float(q.g0), g1 = float(q.g1), g2 = float(q.g2), k = float(q.k);
+    weight = float(q.weight);
+  }
+};
+
+// The queue of edges by cost: a radix heap (Ahuja, Mehlhorn, Orlin & Tarjan 1990) over the
+// bit patterns of the float costs (non-negative floats order like their bits). It needs
+// keys that never drop below the last one taken, which quadrics nearly guarantee: merging
+// only adds planes, so an edge's cost only grows; a key below (a fresh re-evaluation of a
+// refused edge) is taken next, as a binary heap would. Pushing appends to a bucket and
+// taking redistributes one bucket, both sequential sweeps: no sift through a tree of
+// random cache lines, which dominated a binary heap's cost here. At most one entry per
+// edge: an entry whose edge changed since is marked stale and re-evaluated when it surfaces
+// (lazy updates); stale costs are lower bounds, so nothing is taken too late.
+class EdgeQueue {
+ public:
+  static std::uint32_t key(float cost) {
+    std::uint32_t bits;
+    std::memcpy(&bits, &cost, sizeof bits);
+    return bits;
+  }
+  bool empty() const { return size_ == 0; }
+  void clear() {
+    for (auto& b : buckets_) b.clear();
+    size_ = 0;
+    last_ = 0;
+  }
+  void push(float cost, Index edge) {
+    std::uint32_t k = key(cost);
+    if (k < last_) k = last_;
+    buckets_[bucket(k)].push_back({k, edge});
+    ++size_;
+  }
+  //! The edge of least cost; precondition: !empty().
+  Index top() {
+    if (buckets_[0].empty()) refill();
+    return buckets_[0].back().edge;
+  }
+  void pop() {
+    buckets_[0].pop_back();
+    --size_;
+  }
+
+ private:
+  struct Entry {
+    std::uint32_t key;
+    Index edge;
+  };
+  int bucket(std::uint32_t k) const { return k == last_ ? 0 : 32 - std::countl_zero(k ^ last_); }
+  void refill() {
+    int i = 1;
+    while (buckets_[i].empty()) ++i;
+    std::vector<Entry>& from = buckets_[i];
+    std::uint32_t least = from.front().key;
+    for (const Entry& e : from) least = std::min(least, e.key);
+    last_ = least;
+    for (const Entry& e : from) buckets_[bucket(e.key)].push_back(e);
+    from.clear();
+  }
+  std::vector<Entry> buckets_[33];
+  std::uint32_t last_ = 0;
+  std::size_t size_ = 0;
+};
+
+enum EdgeState : std::uint8_t { kOutOfHeap = 0, kInHeap = 1, kStale = 2, kDead = 3 };
+
+// The best collapse of one edge, as last evaluated.
+struct Candidate {
+  Point position;     // where the kept vertex goes
+  float cost;         // quadric error there (area x squared distance, in units of the diagonal)
+  float kept_weight;  // interpolation weight of the kept vertex's attributes
+  std::uint8_t side;  // collapse halfedge(e, side): its from_vertex goes
+};
+
+// Per-vertex flags, kept in one byte array next to the quadrics. The seam bits say what a
+// vertex may do with respect to seams of per-corner attributes: kOnSeam when a seam edge
+// touches it, kSeamLine when it lies inside one seam (it may slide along it), kLockedSeam
+// for seam ends, junctions and seams meeting the boundary (it stays).
+enum VertexFlag : std::uint8_t { kBoundary = 1, kOnSeam = 2, kSeamLine = 4, kLockedSeam = 8 };
+constexpr std::uint8_t kSeamBits = kOnSeam | kSeamLine | kLockedSeam;
+
+// Boundary edges add a plane through the edge, perpendicular to its face, so moving a
+// boundary vertex off the boundary's line costs (Garland & Heckbert's boundary constraint).
+constexpr double kBoundaryWeight = 10;
+
+// Linear blend of one f32 channel element, without the allocation of the generic path.
+void lerp_f32(ChannelArray& c, std::size_t to, const std::byte* a, const std::byte* b, float t) {
+  const int n = c.components();
+  float x[16], y[16];
+  std::memcpy(x, a, sizeof(float) * n);
+  std::memcpy(y, b, sizeof(float) * n);
+  for (int k = 0; k < n; ++k) x[k] = x[k] + (y[k] - x[k]) * t;
+  std::memcpy(c.element(to), x, sizeof(float) * n);
+}
+
+bool is_internal(const PropertyArray& a) { return a.name().starts_with("hedge:"); }
+
+class Decimator {
+ public:
+  Decimator(Mesh& mesh, const DecimateOptions& options, Progress& progress)
+      : m_(mesh), opt_(options), progress_(progress) {}
+
+  DecimateReport run();
+
+ private:
+  // ---- setup -------------------------------------------------------------------------
+  void triangulate_polygons();
+  void compute_frame();
+  void compute_quadrics();
+  void find_corner_channels();
+  void classify_vertices();
+  std::uint8_t classify(Vertex v) const;
+  void fill_heap();
+
+  // ---- evaluation ----------------------------------------------------------------------
+  Vec3d local(Vertex v) const { return (to_double(m_.position(v)) - center_) * inv_scale_; }
+  Vec3d at(Vertex v) const { return to_double(vd_[v.idx()].position); }
+  Point world(const Vec3d& p) const { return to_float(center_ + p * scale_); }
+  bool corners_equal(Halfedge a, Halfedge b) const {
+    for (const ChannelArray* c : corner_channels_)
+      if (std::memcmp(c->element(a.idx()), c->element(b.idx()), c->stride()) != 0) return false;
+    return true;
+  }
+  bool evaluate(Edge e, Candidate& c) const;
+  double boundary_shift(Halfedge h0, const Vec3d& p) const;
+  void push(Edge e, float cost) { heap_.push(cost, e.idx()); }
+  // Re-evaluates e and queues it; an edge without any legal placement stays out.
+  void requeue(Edge e) {
+    Candidate c;
+    if (evaluate(e, c)) {
+      state_[e.idx()] = kInHeap;
+      push(e, c.cost);
+    } else {
+      state_[e.idx()] = kOutOfHeap;
+    }
+  }
+  // The edge's endpoints changed: its queued cost is now a lower bound (quadrics only grow).
+  void touch(Edge e) {
+    std::uint8_t& state = state_[e.idx()];
+    if (state == kInHeap)
+      state = kStale;
+    else if (state == kOutOfHeap)
+      requeue(e);
+  }
+
+  // ---- collapsing ----------------------------------------------------------------------
+  bool is_legal(Halfedge h, const Point& target) const;
+  bool triangle_ok(const Vec3d& old_apex, const Vec3d& new_apex, const Vec3d& a, const Vec3d& b) const;
+  bool collapse(Halfedge h, const Candidate& c);
+  void gather_wedges(Halfedge h);
+  void blend_wedges(Vertex kept, float kept_weight);
+  void interpolate_vertex(Vertex removed, Vertex kept, float kept_weight);
+
+  Mesh& m_;
+  const DecimateOptions& opt_;
+  Progress& progress_;
+
+  Vec3d center_{};
+  double scale_ = 1, inv_scale_ = 1;
+  double cos_max_normal_change_ = 0;
+  bool seam_mode_ = false;
+  bool has_boundary_ = false;
+
+  // Everything evaluate() reads about a vertex, in one cache line: its quadric (about its
+  // position), its position in the normalized frame, valence and flags. The loop is bound
+  // by cache misses, not arithmetic.
+  struct alignas(64) VertexData {
+    PackedQuadric quadric;
+    Vec3f position;
+    std::uint16_t valence = 0;
+    std::uint8_t flags = 0;
+  };
+  std::vector<VertexData> vd_;
+  std::vector<std::uint8_t> state_;  // EdgeState per edge: one byte, so touching edges stays in cache
+  EdgeQueue heap_;
+  struct RingEntry {
+    Vertex vertex;  // a neighbour, in counter-clockwise order
+    Face face;      // the face between it and the next neighbour (invalid: a hole)
+    Vec3d position;
+  };
+  mutable std::vector<RingEntry> ring0_, ring1_;  // scratch of is_legal()
+  mutable int refusal_ = 0;  // which test refused the last collapse (for debugging)
+
+  std::vector<ChannelArray*> corner_channels_;  // host per-corner channels (seams are judged on these)
+  // Vertex properties with their fast path resolved once.
+  struct VertexArray {
+    PropertyArray* array;
+    ChannelArray* f32;
+  };
+  std::vector<VertexArray> vertex_arrays_;
+
+  // Scratch of one collapse (reused: no allocation per collapse).
+  std::vector<Face> wedge_faces_[2];       // faces whose corner at the kept vertex joins wedge l / r
+  std::vector<std::byte> wedge_values_;    // corner values: [l removed, l kept, r removed, r kept] per channel
+  bool wedge_present_[2] = {false, false};
+  Index interp_index_[2];
+  float interp_weight_[2];
+
+  std::size_t faces_ = 0;
+  std::size_t target_ = 0;
+  DecimateReport report_;
+  double max_error_sq_seen_ = 0;
+  bool refused_for_error_ = false;
+  bool skipped_for_parity_ = false;
+};
+
+void Decimator::triangulate_polygons() {
+  std::vector<Face> polygons;
+  for (Face f : m_.faces())
+    if (m_.next(m_.next(m_.next(m_.halfedge(f)))) != m_.halfedge(f)) polygons.push_back(f);
+  for (Face f : polygons) m_.triangulate(f);
+  report_.triangulated_faces = polygons.size();
+}
+
+// Quadrics are built in coordinates centred on the bounding box and scaled by its diagonal:
+// errors come out as fractions of the diagonal and keep their precision far from the origin.
+void Decimator::compute_frame() {
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  Vec3d lo{{inf, inf, inf}}, hi{{-inf, -inf, -inf}};
+  for (Vertex v : m_.vertices()) {
+    const Vec3d p = to_double(m_.position(v));
+    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
+  }
+  center_ = (lo + hi) * 0.5;
+  scale_ = distance(lo, hi);
+  if (!(scale_ > 0) || !std::isfinite(scale_)) scale_ = 1;
+  inv_scale_ = 1 / scale_;
+}
+
+void Decimator::compute_quadrics() {
+  vd_.assign(m_.vertices_size(), VertexData());
+  for (Vertex v : m_.vertices()) vd_[v.idx()].position = to_float(local(v));
+  std::vector<Quadric> sum(m_.vertices_size());
+  // Face planes weighted by area, so that a region's error does not depend on how finely
+  // it happens to be tessellated.
+  for (Face f : m_.faces()) {
+    const Halfedge h = m_.halfedge(f);
+    const Vertex a = m_.to_vertex(h), b = m_.to_vertex(m_.next(h)), c = m_.to_vertex(m_.prev(h));
+    const Vec3d pa = at(a), pb = at(b), pc = at(c);
+    Vec3d n = cross(pb - pa, pc - pa);
+    const double len = norm(n);
+    if (!(len > 0)) continue;
+    n /= len;
+    for (Vertex v : {a, b, c}) sum[v.idx()].add_plane(n, dot(n, at(v) - pa), 0.5 * len);
+  }
+  for (Edge e : m_.edges()) {
+    Halfedge h = Mesh::halfedge(e, 0);
+    if (!m_.is_boundary(h)) h = Mesh::opposite(h);
+    if (!m_.is_boundary(h)) continue;
+    has_boundary_ = true;
+    const Halfedge inner = Mesh::opposite(h);
+    const Vertex a = m_.from_vertex(inner), b = m_.to_vertex(inner), c = m_.to_vertex(m_.next(inner));
+    const Vec3d pa = at(a), pb = at(b), pc = at(c);
+    const Vec3d along = pb - pa;
+    const Vec3d face_normal = cross(along, pc - pa);
+    Vec3d n = cross(along, face_normal);
+    const double len = norm(n);
+    if (!(len > 0)) continue;
+    n /= len;
+    for (Vertex v : {a, b}) sum[v.idx()].add_plane(n, dot(n, at(v) - pa), kBoundaryWeight * sqrnorm(along));
+  }
+  for (Vertex v : m_.vertices()) vd_[v.idx()].quadric.store(sum[v.idx()]);
+}
+
+void Decimator::find_corner_channels() {
+  PropertyContainer& hp = m_.halfedge_properties();
+  for (std::size_t i = 0; i < hp.count(); ++i) {
+    PropertyArray& a = hp.at(i);
+    if (a.type() == typeid(ChannelArray) && !is_internal(a)) corner_channels_.push_back(static_cast<ChannelArray*>(&a));
+  }
+  seam_mode_ = opt_.preserve_uv_seams && !corner_channels_.empty();
+
+  PropertyContainer& vp = m_.vertex_properties();
+  for (std::size_t i = 0; i < vp.count(); ++i) {
+    PropertyArray& a = vp.at(i);
+    ChannelArray* f32 = nullptr;
+    if (a.type() == typeid(ChannelArray)) {
+      auto* c = static_cast<ChannelArray*>(&a);
+      if (c->scalar() == ScalarType::f32 && c->components() <= 16) f32 = c;
+    }
+    vertex_arrays_.push_back({&a, f32});
+  }
+}
+
+// A vertex is plain when no seam edge touches it; a seam vertex when it lies inside one seam
+// (two seam edges, its corners in two wedges); locked otherwise: seam ends and junctions,
+// and seams meeting the boundary, keep their place so the charts keep their shape.
+std::uint8_t Decimator::classify(Vertex v) const {
+  int seams = 0, splits = 0;
+  bool boundary = false;
+  for (Halfedge x : m_.outgoing(v)) {
+    const Halfedge ox = Mesh::opposite(x);
+    if (m_.is_boundary(x) || m_.is_boundary(ox)) {
+      boundary = true;
+      continue;
+    }
+    const bool differ_here = !corners_equal(m_.prev(x), ox);
+    const bool differ_there = !corners_equal(x, m_.prev(ox));
+    splits += differ_here;
+    seams += differ_here || differ_there;
+  }
+  if (seams == 0) return 0;
+  if (seams == 2 && splits == 2 && !boundary) return kOnSeam | kSeamLine;
+  return kOnSeam | kLockedSeam;
+}
+
+void Decimator::classify_vertices() {
+  for (Halfedge h : m_.halfedges()) {
+    auto& n = vd_[m_.from_vertex(h).idx()].valence;
+    if (n < std::numeric_limits<std::uint16_t>::max()) ++n;
+  }
+  for (Vertex v : m_.vertices()) {
+    std::uint8_t f = m_.is_boundary(v) ? kBoundary : 0;
+    if (seam_mode_) f |= classify(v);
+    vd_[v.idx()].flags = f;
+  }
+}
+
+// The cheapest legal placement for collapsing e. Which end may go and which may move
+// follows from the boundary and seam rules; the position is the quadric's minimum when
+// both ends are free, else the best point of the edge, else the fixed end.
+namespace {
+double segment_sq(const Vec3d& q, const Vec3d& a, const Vec3d& b) {
+  const Vec3d d = b - a;
+  const double dd = sqrnorm(d);
+  const double t = dd > 0 ? std::clamp(dot(q - a, d) / dd, 0.0, 1.0) : 0.0;
+  return sqrnorm(q - (a + d * t));
+}
+// Squared distance from q to the polyline x - p - y.
+double polyline_sq(const Vec3d& q, const Vec3d& x, const Vec3d& p, const Vec3d& y) {
+  return std::min(segment_sq(q, x, p), segment_sq(q, p, y));
+}
+}  // namespace
+
+// How far the boundary line moves when the boundary vertices among the ends of e go to p:
+// the squared distance of each old vertex to the new polyline. Boundary quadrics only see
+// distances across the boundary's edges; a thin tongue retracting along itself costs them
+// nothing, this does.
+double Decimator::boundary_shift(Halfedge h0, const Vec3d& p) const {
+  const Halfedge o0 = Mesh::opposite(h0);
+  const Vertex a = m_.to_vertex(o0), b = m_.to_vertex(h0);
+  if (m_.is_boundary(h0) || m_.is_boundary(o0)) {
+    const Halfedge hb = m_.is_boundary(h0) ? h0 : o0;
+    const Vec3d x = at(m_.from_vertex(m_.prev(hb))), y = at(m_.to_vertex(m_.next(hb)));
+    return std::max(polyline_sq(at(a), x, p, y), polyline_sq(at(b), x, p, y));
+  }
+  double shift = 0;
+  for (Vertex v : {a, b}) {
+    if (!(vd_[v.idx()].flags & kBoundary)) continue;
+    const Halfedge hb = m_.halfedge(v);  // its outgoing boundary half-edge
+    shift = std::max(shift, polyline_sq(at(v), at(m_.from_vertex(m_.prev(hb))), p, at(m_.to_vertex(hb))));
+  }
+  return shift;
+}
+
+// The cheapest legal placement for collapsing e. Which end may go and which may move
+// follows from the boundary and seam rules; the position is the quadric's minimum when
+// both ends are free, else the best point of the edge, else the fixed end.
+bool Decimator::evaluate(Edge e, Candidate& c) const {
+  const Halfedge h0 = Mesh::halfedge(e, 0);
+  const Halfedge o0 = Mesh::opposite(h0);
+  const Vertex b = m_.to_vertex(h0), a = m_.to_vertex(o0);  // h0 runs a -> b
+  const bool boundary_edge = m_.is_boundary(h0) || m_.is_boundary(o0);
+  const VertexData &da = vd_[a.idx()], &db = vd_[b.idx()];
+  const std::uint8_t fa = da.flags, fb = db.flags;
+
+  bool seam = false, seam_both = false;
+  if (seam_mode_ && !boundary_edge && ((fa | fb) & kOnSeam)) {
+    const bool differ_a = !corners_equal(m_.prev(h0), o0), differ_b = !corners_equal(h0, m_.prev(o0));
+    seam = differ_a || differ_b;
+    seam_both = differ_a && differ_b;
+  }
+  auto removable = [&](std::uint8_t f) {
+    if (opt_.preserve_boundary && (f & kBoundary) && !boundary_edge) return false;
+    if (f & kLockedSeam) return false;
+    if (f & kSeamLine) return seam_both;
+    return true;
+  };
+  auto movable = [&](std::uint8_t f) {
+    if (opt_.preserve_boundary && (f & kBoundary)) return false;
+    if (f & kLockedSeam) return false;
+    if (f & kSeamLine) return seam_both;
+    return true;
+  };
+  const bool ra = removable(fa), rb = removable(fb);
+  if (!ra && !rb) return false;
+  const bool ma = movable(fa), mb = movable(fb);
+  const bool touches_boundary = boundary_edge || ((fa | fb) & kBoundary);
+
+  // Everything relative to a: both quadrics about a, a at the origin, b at ab.
+  const Vec3d pa = to_double(da.position), pb = to_double(db.position);
+  const Vec3d ab = pb - pa;
+  const Quadric q = da.quadric.unpack() + db.quadric.unpack().shifted(-ab);
+  const double boundary_weight = kBoundaryWeight * sqrnorm(ab);
+  if ((ra && mb) || (rb && ma)) {
+    // Both ends free: the removed vertex is whichever may go (a when both may).
+    const bool remove_a = ra && mb;
+    const Vec3d from = remove_a ? Vec3d{} : ab, to = remove_a ? ab : Vec3d{};
+    const Vec3d d = to - from;
+    const double dd = sqrnorm(d);
+    Vec3d p;
+    bool found = false;
+    // Seams move only along themselves: the minimum over the edge keeps the new vertex on
+    // the seam line, where both charts' coordinates can be interpolated.
+    if (!seam && q.minimum(p)) {
+      // A nearly flat neighbourhood can put the minimum far along a valley of the quadric;
+      // such a point is a numerical accident, not a better surface.
+      found = sqrnorm(p - ab * 0.5) <= 4 * dd;
+    }
+    double t;  // along the edge from the removed vertex, for attribute interpolation
+    double cost;
+    if (!found) {
+      const double curvature = dot(d, q.times(d));
+      const double slope = dot(q.times(from) + q.linear(), d);
+      t = curvature > 0 ? std::clamp(-slope / curvature, 0.0, 1.0) : (slope > 0 ? 0.0 : slope < 0 ? 1.0 : 0.5);
+      p = from + d * t;
+      cost = q(p);
+    } else {
+      t = dd > 0 ? std::clamp(dot(p - from, d) / dd, 0.0, 1.0) : 0.5;
+      cost = std::max(0.0, q.k + dot(q.linear(), p));  // at the minimum, A p = -g
+    }
+    if (touches_boundary) cost += boundary_weight * boundary_shift(h0, pa + p);
+    c.position = world(pa + p);
+    c.cost = static_cast<float>(cost);
+    c.kept_weight = static_cast<float>(t);
+    c.side = remove_a ? 0 : 1;
+    return true;
+  }
+  // One end stays where it is.
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  double cost_keep_b = ra ? q(ab) : inf, cost_keep_a = rb ? q(Vec3d{}) : inf;
+  if (touches_boundary) {
+    if (ra) cost_keep_b += boundary_weight * boundary_shift(h0, pb);
+    if (rb) cost_keep_a += boundary_weight * boundary_shift(h0, pa);
+  }
+  const bool keep_b = cost_keep_b <= cost_keep_a;
+  c.position = m_.position(keep_b ? b : a);
+  c.cost = static_cast<float>(keep_b ? cost_keep_b : cost_keep_a);
+  c.kept_weight = 1;
+  c.side = keep_b ? 0 : 1;
+  return true;
+}
+
+void Decimator::fill_heap() {
+  state_.assign(m_.edges_size(), kOutOfHeap);
+  heap_.clear();
+  std::size_t done = 0;
+  const double total = double(std::max<std::size_t>(1, m_.n_edges()));
+  for (Edge e : m_.edges()) {
+    Candidate c;
+    if (evaluate(e, c)) {
+      state_[e.idx()] = kInHeap;
+      heap_.push(c.cost, e.idx());
+    }
+    if ((++done & 0xffff) == 0) progress_.update(0.1 * done / total, "measuring edges");
+  }
+}
+
+// Rotation limit and degeneracy of one triangle (apex, a, b) when its apex moves.
+bool Decimator::triangle_ok(const Vec3d& old_apex, const Vec3d& new_apex, const Vec3d& a, const Vec3d& b) const {
+  if (opt_.prevent_flips) {
+    const Vec3d n_old = cross(a - old_apex, b - old_apex);
+    const Vec3d ea = a - new_apex, eb = b - new_apex;
+    const Vec3d n_new = cross(ea, eb);
+    const double longest = std::max({sqrnorm(ea), sqrnorm(eb), sqrnorm(b - a)});
+    const double new_sq = sqrnorm(n_new);
+    // Degenerate: height below a millionth of the longest edge.
+    if (!(new_sq > 1e-12 * longest * longest)) return false;
+    const double old_sq = sqrnorm(n_old);
+    if (old_sq > 0 && dot(n_old, n_new) < cos_max_normal_change_ * std::sqrt(old_sq * new_sq)) return false;
+  }
+  if (opt_.min_quality > 0) {
+    const double q_new = triangle_quality(new_apex, a, b);
+    if (q_new < opt_.min_quality && q_new < triangle_quality(old_apex, a, b)) return false;
+  }
+  return true;
+}
+
+// The link condition (Dey et al.), pmp's and OpenMesh's guards against pinching and
+// pillows, and the geometric checks on every triangle that survives around both ends.
+// Stricter than Mesh::is_collapse_ok(), in O(valence) with marks instead of searches.
+bool Decimator::is_legal(Halfedge h, const Point& target) const {
+  const Halfedge o = Mesh::opposite(h);
+  const Vertex v0 = m_.to_vertex(o), v1 = m_.to_vertex(h);
+  const Face fl = m_.face(h), fr = m_.face(o);
+  Vertex vl, vr;
+  if (fl.is_valid()) {
+    const Halfedge hn = m_.next(h), hp = m_.prev(h);
+    vl = m_.to_vertex(hn);
+    if (m_.is_boundary(Mesh::opposite(hn)) && m_.is_boundary(Mesh::opposite(hp))) { refusal_ = 1; return false; }
+    if (vd_[vl.idx()].valence <= 3 && !(vd_[vl.idx()].flags & kBoundary)) { refusal_ = 2; return false; }
+  }
+  if (fr.is_valid()) {
+    const Halfedge on = m_.next(o), op = m_.prev(o);
+    vr = m_.to_vertex(on);
+    if (m_.is_boundary(Mesh::opposite(on)) && m_.is_boundary(Mesh::opposite(op))) { refusal_ = 3; return false; }
+    if (vd_[vr.idx()].valence <= 3 && !(vd_[vr.idx()].flags & kBoundary)) { refusal_ = 4; return false; }
+  }
+  // A hole of three edges would become a 2-gon (possible where build() left a multi-edge).
+  if (!fl.is_valid() && m_.next(m_.next(m_.next(h))) == h) { refusal_ = 5; return false; }
+  if (!fr.is_valid() && m_.next(m_.next(m_.next(o))) == o) { refusal_ = 6; return false; }
+  const bool b0 = vd_[v0.idx()].flags & kBoundary, b1 = vd_[v1.idx()].flags & kBoundary;
+  if (fl.is_valid() && fr.is_valid()) {
+    if (vl == vr) { refusal_ = 7; return false; }
+    if (b0 && b1) { refusal_ = 8; return false; }
+  }
+  const int removed_faces = int(fl.is_valid()) + int(fr.is_valid());
+  if (!b0 && !b1 && int(vd_[v0.idx()].valence) + int(vd_[v1.idx()].valence) - 2 - removed_faces < 3) { refusal_ = 9; return false; }
+
+  // The two rings, in order: each entry is a neighbour and the face between it and the next.
+  auto gather = [&](Vertex v, std::vector<RingEntry>& ring) {
+    ring.clear();
+    for (Halfedge x : m_.outgoing(v)) ring.push_back({m_.to_vertex(x), m_.face(x), Vec3d{}});
+  };
+  gather(v0, ring0_);
+  gather(v1, ring1_);
+  // Link condition: the only common neighbours are vl and vr; and a second edge v0 - v1
+  // would become a loop. The rings are short, so plain scans beat marking arrays.
+  int edges_to_v1 = 0;
+  for (const RingEntry& r : ring0_) edges_to_v1 += r.vertex == v1;
+  if (edges_to_v1 > 1) { refusal_ = 10; return false; }
+  for (const RingEntry& r1 : ring1_) {
+    if (r1.vertex == vl || r1.vertex == vr || r1.vertex == v0) continue;
+    for (const RingEntry& r0 : ring0_)
+      if (r0.vertex == r1.vertex) { refusal_ = 12; return false; }
+  }
+  // Every triangle that stays, around either end, with its apex moved to the target.
+  const Vec3d p_new = to_double(target);
+  auto faces_ok = [&](Vertex v, std::vector<RingEntry>& ring) {
+    for (RingEntry& r : ring) r.position = to_double(m_.position(r.vertex));
+    const Vec3d apex = to_double(m_.position(v));
+    const std::size_t n = ring.size();
+    for (std::size_t i = 0; i < n; ++i) {
+      const Face f = ring[i].face;
+      if (!f.is_valid() || f == fl || f == fr) continue;
+      if (!triangle_ok(apex, p_new, ring[i].position, ring[i + 1 == n ? 0 : i + 1].position)) return false;
+    }
+    return true;
+  };
+  if (!faces_ok(v0, ring0_)) { refusal_ = 11; return false; }
+  if (!faces_ok(v1, ring1_)) { refusal_ = 13; return false; }
+  return true;
+}
+
+// Before collapsing h (v0 -> v1): the wedges that merge. Across the triangle on the left,
+// v0's corners continuous with its corner there join v1's corners continuous with v1's
+// corner there (wedge l); likewise on the right (wedge r). Corners in other wedges keep
+// their values. The four corner values are saved, since the collapse overwrites some.
+void Decimator::gather_wedges(Halfedge h) {
+  const Halfedge o = Mesh::opposite(h);
+  const Face fl = m_.face(h), fr = m_.face(o);
+  wedge_faces_[0].clear();
+  wedge_faces_[1].clear();
+  wedge_present_[0] = fl.is_valid();
+  wedge_present_[1] = fr.is_valid();
+
+  // Walks the fan from `start` (an outgoing half-edge whose face holds corner `corner`),
+  // rotating one way, while corners stay equal; stops at a hole or at `stop`.
+  auto walk = [&](Halfedge start, Halfedge corner, bool ccw, Face stop, std::vector<Face>& out) {
+    Halfedge x = start;
+    for (;;) {
+      x = ccw ? m_.ccw_rotated(x) : m_.cw_rotated(x);
+      const Face f = m_.face(x);
+      if (x == start || !f.is_valid() || f == stop) return;
+      const Halfedge c = m_.prev(x);
+      if (!corners_equal(c, corner)) return;
+      out.push_back(f);
+      corner = c;
+    }
+  };
+  if (fl.is_valid()) {
+    walk(h, m_.prev(h), true, fr, wedge_faces_[0]);          // around v0, from fl towards fr
+    walk(m_.next(h), h, false, fr, wedge_faces_[0]);         // around v1, from fl towards fr
+  }
+  if (fr.is_valid()) {
+    walk(m_.next(o), o, false, fl, wedge_faces_[1]);         // around v0, from fr towards fl
+    walk(o, m_.prev(o), true, fl, wedge_faces_[1]);          // around v1, from fr towards fl
+  }
+
+  std::size_t bytes = 0;
+  for (const ChannelArray* c : corner_channels_) bytes += 4 * c->stride();
+  wedge_values_.resize(bytes);
+  std::byte* out = wedge_values_.data();
+  const Halfedge rows[4] = {fl.is_valid() ? m_.prev(h) : h, h, o, fr.is_valid() ? m_.prev(o) : o};
+  for (const ChannelArray* c : corner_channels_)
+    for (Halfedge r : rows) {
+      std::memcpy(out, c->element(r.idx()), c->stride());
+      out += c->stride();
+    }
+}
+
+// After the collapse: each merged wedge takes the blend of its two saved corner values.
+void Decimator::blend_wedges(Vertex kept, float kept_weight) {
+  const float t = kept_weight;
+  for (int side = 0; side < 2; ++side) {
+    if (!wedge_present_[side]) continue;
+    const std::byte* base = wedge_values_.data();
+    for (ChannelArray* c : corner_channels_) {
+      const std::size_t s = c->stride();
+      const std::byte* removed = base + (2 * side) * s;
+      const std::byte* keep = base + (2 * side + 1) * s;
+      base += 4 * s;
+      for (Face f : wedge_faces_[side]) {
+        if (m_.is_deleted(f)) continue;
+        Halfedge x = m_.halfedge(f);
+        while (m_.to_vertex(x) != kept) x = m_.next(x);
+        if (c->scalar() == ScalarType::f32 && c->components() <= 16) {
+          lerp_f32(*c, x.idx(), removed, keep, t);
+        } else if (c->scalar() == ScalarType::f64) {
+          const int n = c->components();
+          std::byte* dst = c->element(x.idx());
+          for (int k = 0; k < n; ++k) {
+            double u, v;
+            std::memcpy(&u, removed + k * sizeof(double), sizeof(double));
+            std::memcpy(&v, keep + k * sizeof(double), sizeof(double));
+            const double w = u + (v - u) * double(t);
+            std::memcpy(dst + k * sizeof(double), &w, sizeof(double));
+          }
+        } else {
+          // Integers (ids, 8-bit colours) are not blended: the nearer end's value.
+          std::memcpy(c->element(x.idx()), t >= 0.5f ? keep : removed, s);
+        }
+      }
+    }
+  }
+}
+
+void Decimator::interpolate_vertex(Vertex removed, Vertex kept, float kept_weight) {
+  if (vertex_arrays_.empty()) return;
+  interp_index_[0] = removed.idx();
+  interp_index_[1] = kept.idx();
+  interp_weight_[0] = 1 - kept_weight;
+  interp_weight_[1] = kept_weight;
+  for (const VertexArray& a : vertex_arrays_) {
+    if (a.f32)
+      lerp_f32(*a.f32, kept.idx(), a.f32->element(removed.idx()), a.f32->element(kept.idx()), kept_weight);
+    else
+      a.array->interpolate(kept.idx(), std::span<const Index>(interp_index_, 2), std::span<const float>(interp_weight_, 2));
+  }
+}
+
+bool Decimator::collapse(Halfedge h, const Candidate& c) {
+  const Halfedge o = Mesh::opposite(h);
+  const Vertex v0 = m_.to_vertex(o), v1 = m_.to_vertex(h);
+  const Face fl = m_.face(h), fr = m_.face(o);
+  const Vertex vl = fl.is_valid() ? m_.to_vertex(m_.next(h)) : Vertex();
+  const Vertex vr = fr.is_valid() ? m_.to_vertex(m_.next(o)) : Vertex();
+  const int removed_faces = int(fl.is_valid()) + int(fr.is_valid());
+
+  // The edges that may go: the collapsed one and one of each merged pair.
+  const Edge doomed[5] = {Mesh::edge(h), Mesh::edge(m_.next(h)), Mesh::edge(m_.prev(h)), Mesh::edge(m_.next(o)),
+                          Mesh::edge(m_.prev(o))};
+  if (!corner_channels_.empty()) gather_wedges(h);
+  try {
+    m_.collapse(h);
+  } catch (const Error&) {
+    // is_legal() is meant to be the stricter test; should the mesh refuse anyway, nothing
+    // has changed yet (gather_wedges only reads) and the edge is simply skipped.
+    return false;
+  }
+  // Queue entries of deleted edges are dropped when they surface, by this mark alone.
+  for (Edge d : doomed)
+    if (m_.is_deleted(d)) state_[d.idx()] = kDead;
+  m_.position(v1) = c.position;
+#ifdef HEDGE_DECIMATE_DEBUG
+  if (Validation val = validate(m_); !val.ok)
+    throw Error("decimate debug: collapse " + std::to_string(report_.collapses) + " of " + std::to_string(v0.idx()) +
+                " into " + std::to_string(v1.idx()) + " broke the mesh: " + val.message);
+#endif
+  // The merged quadric, moved to be about the new position.
+  VertexData &d0 = vd_[v0.idx()], &d1 = vd_[v1.idx()];
+  const Vec3d c0 = to_double(d0.position), c1 = to_double(d1.position);
+  const Vec3d moved = local(v1);
+  d1.quadric.store((d1.quadric.unpack() + d0.quadric.unpack().shifted(c1 - c0)).shifted(moved - c1));
+  d1.position = to_float(moved);
+  interpolate_vertex(v0, v1, c.kept_weight);
+  if (!corner_channels_.empty()) blend_wedges(v1, c.kept_weight);
+
+  d1.valence = static_cast<std::uint16_t>(d0.valence + d1.valence - 2 - removed_faces);
+  if (vl.is_valid()) --vd_[vl.idx()].valence;
+  if (vr.is_valid()) --vd_[vr.idx()].valence;
+  faces_ -= removed_faces;
+
+  // The kept vertex is on the boundary when either end was; vl and vr keep their status.
+  d1.flags = (d0.flags | d1.flags) & kBoundary;
+  if (seam_mode_) {
+    d1.flags |= classify(v1);
+    for (Vertex v : {vl, vr}) {
+      if (!v.is_valid()) continue;
+      const std::uint8_t f = std::uint8_t((vd_[v.idx()].flags & ~kSeamBits) | classify(v));
+      if (f != vd_[v.idx()].flags) {
+        vd_[v.idx()].flags = f;
+        for (Halfedge x : m_.outgoing(v)) touch(Mesh::edge(x));
+      }
+    }
+  }
+  for (Halfedge x : m_.outgoing(v1)) touch(Mesh::edge(x));
+  return true;
+}
+
+DecimateReport Decimator::run() {
+  report_.faces_before = m_.n_faces();
+  report_.vertices_before = m_.n_vertices();
+  cos_max_normal_change_ = std::cos(std::clamp(opt_.max_normal_change_degrees, 0.0, 180.0) * std::numbers::pi / 180);
+
+  progress_.update(0, "preparing");
+  triangulate_polygons();
+  faces_ = m_.n_faces();
+  if (opt_.target_faces > 0)
+    target_ = opt_.target_faces;
+  else
+    target_ = static_cast<std::size_t>(std::llround(opt_.target_ratio * double(faces_)));
+  report_.target_faces = target_;
+  if (faces_ <= target_ || faces_ == 0) {
+    report_.faces_after = faces_;
+    report_.vertices_after = m_.n_vertices();
+    report_.stopped_by = "nothing to do";
+    if (report_.triangulated_faces) m_.garbage_collect();
+    return report_;
+  }
+
+  compute_frame();
+  compute_quadrics();
+  find_corner_channels();
+  classify_vertices();
+  progress_.update(0.05, "measuring edges");
+  fill_heap();
+
+  const double max_error_sq = opt_.max_error * opt_.max_error;
+  const std::size_t to_remove = faces_ - target_;
+  const std::size_t start_faces = faces_;
+  std::size_t collapses_since_fill = 0, refills = 0;
+  std::size_t steps = 0;
+  while (faces_ > target_) {
+    if (heap_.empty()) {
+      // Edges refused earlier (fold-overs, link condition) may be legal now that their
+      // neighbourhood changed: queue every edge again while that still helps.
+      if (collapses_since_fill == 0 || (faces_ == target_ + 1 && skipped_for_parity_) || ++refills > 4) break;
+      collapses_since_fill = 0;
+      for (Edge e : m_.edges())
+        if (state_[e.idx()] == kOutOfHeap) requeue(e);
+      continue;
+    }
+    if ((++steps & 0x3ff) == 0)
+      progress_.update(0.1 + 0.85 * double(start_faces - faces_) / double(to_remove), "collapsing edges");
+
+    const Edge e(heap_.top());
+    heap_.pop();
+    std::uint8_t& state = state_[e.idx()];
+    if (state == kDead) continue;
+    if (state == kStale) {
+      // Its cost only grew (a lower bound was queued): queue it again at its true cost; if
+      // it is still the cheapest it surfaces again at once.
+      requeue(e);
+      continue;
+    }
+    state = kOutOfHeap;
+    // Current: its placement is computed again rather than stored, which keeps the per-edge
+    // state to one byte; the vertex data it reads is needed for the collapse anyway.
+    Candidate c;
+    if (!evaluate(e, c)) continue;
+
+    const Halfedge h = Mesh::halfedge(e, c.side);
+    const PackedQuadric& q0 = vd_[m_.from_vertex(h).idx()].quadric;
+    const PackedQuadric& q1 = vd_[m_.to_vertex(h).idx()].quadric;
+    const double weight = double(q0.weight) + double(q1.weight);
+    const double error_sq = weight > 0 ? double(c.cost) / weight : 0;
+    if (max_error_sq > 0 && error_sq > max_error_sq) {
+      refused_for_error_ = true;
+      continue;
+    }
+    if (faces_ == target_ + 1 && !m_.is_boundary(e)) {
+      // An interior collapse would overshoot by one; only a boundary one fits.
+      skipped_for_parity_ = true;
+      if (!has_boundary_) break;
+      continue;
+    }
+    if (!is_legal(h, c.position) || !collapse(h, c)) continue;
+    ++report_.collapses;
+    ++collapses_since_fill;
+    max_error_sq_seen_ = std::max(max_error_sq_seen_, error_sq);
+  }
+
+#ifdef HEDGE_DECIMATE_DEBUG
+  {
+    int hist[32] = {0}, no_candidate = 0, ok = 0;
+    for (Edge e : m_.edges()) {
+      Candidate c;
+      if (!evaluate(e, c)) { ++no_candidate; continue; }
+      if (is_legal(Mesh::halfedge(e, c.side), c.position)) ++ok; else ++hist[refusal_];
+    }
+    std::fprintf(stderr, "end: %d without candidate, %d legal;", no_candidate, ok);
+    for (int i = 0; i < 32; ++i) if (hist[i]) std::fprintf(stderr, " [%d]=%d", i, hist[i]);
+    std::fprintf(stderr, "\n");
+  }
+#endif
+  progress_.update(0.95, "compacting");
+  m_.garbage_collect();
+  report_.faces_after = m_.n_faces();
+  report_.vertices_after = m_.n_vertices();
+  report_.max_error = std::sqrt(max_error_sq_seen_);
+  if (faces_ <= target_)
+    report_.stopped_by = "target reached";
+  else if (faces_ == target_ + 1 && skipped_for_parity_)
+    report_.stopped_by = "stopped one triangle above the target: an interior collapse removes two";
+  else if (refused_for_error_)
+    report_.stopped_by = "max_error reached";
+  else
+    report_.stopped_by = "no legal collapse left";
+  progress_.update(1, "done");
+  return report_;
+}
+
+void check_options(const DecimateOptions& o) {
+  if (!(o.target_ratio >= 0 && o.target_ratio <= 1))
+    throw Error("decimate: target_ratio must be a number from 0 to 1, got " + std::to_string(o.target_ratio));
+  if (!(o.max_error >= 0 && o.max_error <= 1))
+    throw Error("decimate: max_error must be a number from 0 to 1 (a fraction of the bounding-box diagonal), got " +
+                std::to_string(o.max_error));
+  if (!(o.min_quality >= 0 && o.min_quality <= 1))
+    throw Error("decimate: min_quality must be a number from 0 to 1, got " + std::to_string(o.min_quality));
+  if (!(o.max_normal_change_degrees >= 0 && o.max_normal_change_degrees <= 180))
+    throw Error("decimate: max_normal_change_degrees must be from 0 to 180, got " +
+                std::to_string(o.max_normal_change_degrees));
+  if (o.target_faces > std::size_t(std::numeric_limits<Index>::max()))
+    throw Error("decimate: target_faces is larger than any mesh can be");
+}
+
+}  // namespace
+
+DecimateReport decimate(Mesh& mesh, const DecimateOptions& options, Progress& progress) {
+  check_options(options);
+  // Only a caller-supplied progress can cancel half-way; keep a copy to restore then.
+  std::optional<Mesh> backup;
+  if (&progress != &Progress::none()) backup = mesh;
+  try {
+    return Decimator(mesh, options, progress).run();
+  } catch (...) {
+    if (backup) mesh = std::move(*backup);
+    throw;
+  }
+}
+
+Operation decimate_operation() {
+  Operation op;
+  op.id = "decimate";
+  op.title = "Decimate";
+  op.category = "Remeshing";
+  op.help =
+      "Reduces the number of triangles while keeping the shape: repeatedly collapses the edge whose removal "
+      "changes the surface least, measured by quadric error metrics (Garland and Heckbert, SIGGRAPH 1997), and "
+      "puts the merged vertex where the error is smallest. Use it to make scans and dense meshes light enough to "
+      "display, edit or send. Polygons are triangulated first. Vertex attributes are interpolated; per-corner "
+      "attributes such as UVs are interpolated per wedge and kept continuous across seams (Hoppe 1999). "
+      "Boundaries stay in place by default and no triangle is flipped. It does not keep sharp creases specially "
+      "(the quadrics already favour them), does not weigh attributes in the error, and changes the "
+      "topology never: holes, handles and components stay.";
+  op.params = {
+      ParamSpec::integer("target_faces", "Target faces", 0, 0, 2147483647,
+                         "Number of triangles to reach; 0 uses the target ratio instead. On a closed surface an "
+                         "odd count stops one above it, since a collapse there removes two triangles."),
+      ParamSpec::real("target_ratio", "Target ratio", 0.5, 0, 1,
+                      "Fraction of the triangles to keep, when target faces is 0."),
+      ParamSpec::real("max_error", "Max error", 0, 0, 1,
+                      "Never collapse an edge whose error exceeds this fraction of the bounding-box diagonal "
+                      "(it may then stop above the target); 0 = no limit."),
+      ParamSpec::boolean("preserve_boundary", "Preserve boundary", true,
+                         "Boundary vertices stay where they are; boundary edges only collapse along the boundary."),
+      ParamSpec::boolean("preserve_uv_seams", "Preserve UV seams", true,
+                         "Keep per-corner attributes (UVs, corner normals, colours) continuous: vertices on a seam "
+                         "only move along it, seam ends and junctions stay."),
+      ParamSpec::boolean("prevent_flips", "Prevent flips", true,
+                         "Refuse collapses that turn a triangle over (normal change above 90 degrees) or make it "
+                         "degenerate."),
+      ParamSpec::real("min_quality", "Min triangle quality", 0, 0, 1,
+                      "Refuse collapses that create triangles of quality (2 inradius / circumradius, 1 = "
+                      "equilateral) below this, unless the triangles they replace were already worse."),
+  };
+  op.run = [](Mesh& mesh, const ParamValues& params, Progress& progress) {
+    DecimateOptions o;
+    o.target_faces = static_cast<std::size_t>(params.get_int("target_faces"));
+    o.target_ratio = params.get_real("target_ratio");
+    o.max_error = params.get_real("max_error");
+    o.preserve_boundary = params.get_bool("preserve_boundary");
+    o.preserve_uv_seams = params.get_bool("preserve_uv_seams");
+    o.prevent_flips = params.get_bool("prevent_flips");
+    o.min_quality = params.get_real("min_quality");
+    const DecimateReport r = decimate(mesh, o, progress);
+    OperationReport report;
+    auto count = [](std::size_t n) { return static_cast<std::int64_t>(n); };
+    report.add("faces_before", count(r.faces_before));
+    report.add("faces_after", count(r.faces_after));
+    report.add("vertices_before", count(r.vertices_before));
+    report.add("vertices_after", count(r.vertices_after));
+    report.add("target_faces", count(r.target_faces));
+    report.add("collapses", count(r.collapses));
+    report.add("triangulated_faces", count(r.triangulated_faces));
+    report.add("max_error", r.max_error);
+    report.add("stopped_by", r.stopped_by);
+    return report;
+  };
+  return op;
+}
+
+}  // namespace hedge
