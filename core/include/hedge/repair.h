@@ -56,7 +56,8 @@ struct RepairReport {
 //! without any repair:
 //! 1. build()'s splits of non-manifold edges and vertices and its orientation flips are
 //!    kept: the provenance that lets extract() undo them is removed;
-//! 2. with weld_distance > 0, vertices that close are merged (grid of cells, O(n log n)),
+//! 2. with weld_distance > 0, vertices that close are merged, in chains, into the first
+//!    (lowest index) of each group, which keeps its position (grid of cells, O(n log n)),
 //!    faces left with fewer than 3 distinct vertices go, and the mesh is rebuilt (welding
 //!    may make new non-manifold places, which the rebuild splits and the report counts);
 //! 3. duplicate faces (the same vertex set as an earlier face) are removed before that
