@@ -115,3 +115,12 @@ def ply_header(path):
             if line == "end_header":
                 break
     return lines
+
+
+def ply_count(path, element):
+    """The number of `element` (vertex, face) a PLY file declares."""
+    for line in ply_header(path):
+        words = line.split()
+        if len(words) == 3 and words[0] == "element" and words[1] == element:
+            return int(words[2])
+    return None

@@ -36,8 +36,9 @@ def test_decimate(ml, checks, bunny, dragon):
         checks.check(mt.logged(output, "Hedge: Decimate").get("faces_after") == str(faces), "decimate: log agrees with the file")
     out, output = run(ml, checks, "decimate_faces", dragon, [mt.hedge_filter(ml, "decimate", target_faces=20000)])
     if out:
-        info = ml.info(out)
-        checks.check(abs(info["faces"] - 20000) <= 1, f"decimate: dragon to 20000 faces = {info['faces']}")
+        # Counted in the file: a non-manifold input's copies are welded back on the way out.
+        faces = mesh_files.ply_count(out, "face")
+        checks.check(faces is not None and abs(faces - 20000) <= 1, f"decimate: non-manifold dragon to 20000 faces = {faces}")
 
 
 def test_subdivide(ml, checks, bunny):
