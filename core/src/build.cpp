@@ -3,10 +3,12 @@
 #include "hedge/build.h"
 
 #include <algorithm>
+#include <cstdint>
 #include <atomic>
 #include <cstdlib>
 #include <cstring>
 #include <memory>
+#include <new>
 #include <string>
 #include <thread>
 #include <type_traits>
@@ -19,31 +21,6 @@
 #include <sys/mman.h>
 #endif
 
-#ifdef HEDGE_BUILD_PROFILE
-#include <sys/resource.h>
-
-#include <chrono>
-#include <cstdio>
-inline double cpu_ms() {
-  rusage u;
-  getrusage(RUSAGE_SELF, &u);
-  return (u.ru_utime.tv_sec + u.ru_stime.tv_sec) * 1e3 + (u.ru_utime.tv_usec + u.ru_stime.tv_usec) * 1e-3;
-}
-#define PHASE(name)                                                                                              \
-  do {                                                                                                           \
-    auto now_ = std::chrono::steady_clock::now();                                                                \
-    double cpu_ = cpu_ms();                                                                                      \
-    std::fprintf(stderr, "%-12s wall %7.2f cpu %7.2f ms\n", name,                                                \
-                 std::chrono::duration<double, std::milli>(now_ - phase_t0).count(), cpu_ - phase_cpu0);         \
-    phase_t0 = now_;                                                                                             \
-    phase_cpu0 = cpu_;                                                                                           \
-  } while (0)
-#else
-#define PHASE(name) \
-  do {              \
-  } while (0)
-#endif
-
 namespace hedge {
 namespace {
 
@@ -54,14 +31,13 @@ constexpr std::uint32_t kDirBit = 0x80000000u;
 
 constexpr std::uint8_t kFaceOk = 0, kFaceRepeats = 1, kFaceSkipped = 2;
 
-// Below this many corners a second thread costs more than it saves.
-constexpr std::size_t kMinParallelCorners = std::size_t(1) << 16;
+// Below this many elements a second thread costs more than it saves.
+constexpr std::size_t kMinParallel = std::size_t(1) << 16;
 
 // Runs fn(begin, end) over [0, n) on two threads when n is large enough to pay for
 // starting one; the split point is fixed, so results do not depend on timing.
 template <class Fn>
 void parallel_ranges(std::size_t n, Fn&& fn) {
-  constexpr std::size_t kMinParallel = std::size_t(1) << 16;
   if (n < kMinParallel || std::thread::hardware_concurrency() < 2) {
     fn(std::size_t(0), n);
     return;
@@ -109,7 +85,6 @@ class Scratch {
   const T& operator[](std::size_t i) const { return data_[i]; }
   T* get() { return data_; }
   const T* get() const { return data_; }
-  explicit operator bool() const { return data_ != nullptr; }
   void reset() {
     memory_.reset();
     bytes_ = 0;
@@ -238,15 +213,18 @@ void invert_links(const std::uint32_t* succ, std::uint32_t k, std::uint32_t* pre
 
 // True when the linked corners form one fan; then `first` is the corner whose entering
 // edge is on the boundary (any corner of a closed fan) and `last` the one whose leaving
-// edge is (kInv for a closed fan).
-bool one_fan(const std::uint32_t* succ, const std::uint32_t* pred, std::uint32_t k, std::uint32_t& first,
-             std::uint32_t& last) {
-  std::uint32_t start = kInv, starts = 0;
-  for (std::uint32_t i = 0; i < k; ++i)
-    if (pred[i] == kInv && starts++ == 0) start = i;
-  if (starts > 1) return false;
-  const bool closed = starts == 0;
-  if (closed) start = 0;
+// edge is (kInv for a closed fan). One fan has k or k - 1 links; with k - 1 the one corner
+// that no link enters is the xor of all corners and all link targets.
+bool one_fan(const std::uint32_t* succ, std::uint32_t k, std::uint32_t& first, std::uint32_t& last) {
+  std::uint32_t links = 0, unentered = 0;
+  for (std::uint32_t i = 0; i < k; ++i) {
+    const bool linked = succ[i] != kInv;
+    links += linked;
+    unentered ^= linked ? i ^ succ[i] : i;
+  }
+  if (links + 1 < k) return false;
+  const bool closed = links == k;
+  const std::uint32_t start = closed ? 0 : unentered;
   std::uint32_t count = 0, i = start, end = start;
   do {
     end = i;
@@ -272,10 +250,6 @@ class Builder {
         corner_(soup.corners.data()) {}
 
   BuildResult run() {
-#ifdef HEDGE_BUILD_PROFILE
-    phase_t0 = std::chrono::steady_clock::now();
-    phase_cpu0 = cpu_ms();
-#endif
     classify_faces();
     if (has_skipped_ || has_repeats_ || !build_local()) build_general();
     finish();
@@ -299,7 +273,7 @@ class Builder {
     soff_[nf_] = offset;
     status_.assign(nf_, kFaceOk);
     fmid_ = nf_;
-    if (nc_ >= kMinParallelCorners && std::thread::hardware_concurrency() >= 2)
+    if (nc_ >= kMinParallel && std::thread::hardware_concurrency() >= 2)
       fmid_ = static_cast<std::size_t>(std::upper_bound(soff_.begin(), soff_.end(), offset / 2) - soff_.begin()) - 1;
     struct Part {
       std::vector<std::uint32_t> skipped;
@@ -337,7 +311,6 @@ class Builder {
     result_.report.repeated_vertex_faces = parts[0].repeats + parts[1].repeats;
     has_repeats_ = result_.report.repeated_vertex_faces > 0;
     has_skipped_ = result_.report.skipped_faces > 0;
-    PHASE("faces");
   }
 
   // The fast path, for soups that need no flip and no face skipped or split inside: any
@@ -362,7 +335,6 @@ class Builder {
       }
       vstart[nv_] = sum;
     }
-    PHASE("count");
     Scratch<VertexCorner> list(nc_);
     auto fill = [&](std::size_t fbegin, std::size_t fend, std::vector<std::uint32_t>& cursor) {
       for (std::size_t f = fbegin; f < fend; ++f) {
@@ -385,7 +357,6 @@ class Builder {
     }
     vertex_corners_[0] = {};
     vertex_corners_[1] = {};
-    PHASE("fill");
 
     // Link the corners around each vertex. out_twin[c] is the twin of the edge leaving
     // corner c: the corner-edge (named by the corner it points to) of the glued face.
@@ -397,7 +368,7 @@ class Builder {
     auto link = [&](std::size_t vbegin, std::size_t vend, int part) {
       std::vector<std::pair<std::uint32_t, std::uint32_t>> by_next, by_prev;
       std::vector<std::uint32_t> big;
-      std::uint32_t small[64];
+      std::uint32_t small[32];
       for (std::size_t v = vbegin; v < vend; ++v) {
         const std::uint32_t k = vstart[v + 1] - vstart[v];
         vfirst[v] = vlast[v] = kInv;
@@ -405,19 +376,17 @@ class Builder {
         if ((v & 1023) == 0 && unclean.load(std::memory_order_relaxed)) return;
         std::uint32_t* succ = small;
         if (k > 32) {
-          big.resize(2 * k);
+          big.resize(k);
           succ = big.data();
         }
-        std::uint32_t* pred = succ + k;
         const VertexCorner* e = list.get() + vstart[v];
         if (!link_corners(e, k, static_cast<std::uint32_t>(v), succ, non_manifold[part], by_next, by_prev)) {
           unclean.store(true, std::memory_order_relaxed);
           return;
         }
         for (std::uint32_t i = 0; i < k; ++i) out_twin[e[i].corner] = succ[i] == kInv ? kInv : e[succ[i]].corner;
-        invert_links(succ, k, pred);
         std::uint32_t first, last;
-        if (one_fan(succ, pred, k, first, last)) {
+        if (one_fan(succ, k, first, last)) {
           vfirst[v] = e[first].corner;
           vlast[v] = last == kInv ? kInv : e[last].corner;
         } else {
@@ -425,7 +394,7 @@ class Builder {
         }
       }
     };
-    if (nc_ >= (std::size_t(1) << 16) && std::thread::hardware_concurrency() >= 2) {
+    if (nc_ >= kMinParallel && std::thread::hardware_concurrency() >= 2) {
       // Split where half the corners lie, so both threads get equal work.
       const std::size_t mid = std::min<std::size_t>(
           nv_, static_cast<std::size_t>(std::upper_bound(vstart.begin(), vstart.end(), vstart[nv_] / 2) - vstart.begin()));
@@ -437,7 +406,6 @@ class Builder {
     }
     if (unclean) return false;
     result_.report.non_manifold_edges = non_manifold[0] + non_manifold[1];
-    PHASE("link");
 
     // Keep the corner lists of the vertices with several fans (few), then reuse the lists'
     // memory for the corner -> half-edge map.
@@ -493,12 +461,10 @@ class Builder {
       number(0, nf_, 0);
     }
     const std::uint32_t ne = edges_in[0] + edges_in[1];
-    PHASE("edges");
 
     Mesh& mesh = result_.mesh;
     mesh.resize(nv_, ne, nf_);
     if (nv_) std::memcpy(mesh.positions().data(), soup_.positions.data(), nv_ * sizeof(Point));
-    PHASE("resize");
     parallel_ranges(nf_, [&](std::size_t fbegin, std::size_t fend) {
       for (std::size_t fi = fbegin; fi < fend; ++fi) {
         const std::uint32_t b = soff_[fi], e = soff_[fi + 1];
@@ -515,7 +481,6 @@ class Builder {
         }
       }
     });
-    PHASE("records");
     // halfedge(v) and the boundary loops: the outer half entering v continues with the one
     // leaving it.
     parallel_ranges(nv_, [&](std::size_t vbegin, std::size_t vend) {
@@ -526,7 +491,6 @@ class Builder {
         if (vlast[v] != kInv) mesh.set_next(opposite(mesh.next(Halfedge(H[vlast[v]]))), out);
       }
     });
-    PHASE("vertices");
 
     // Vertices with several fans (touching at a vertex only): each fan after the first, in
     // the order of their lowest corner, becomes a copy.
@@ -582,7 +546,6 @@ class Builder {
     for (std::size_t v = 0; v < nv_; ++v) result_.report.isolated_vertices += vstart[v + 1] == vstart[v];
     identity_ = true;
     halfedge_of_corner_ = std::move(halfedge_of_corner);
-    PHASE("split");
     return true;
   }
 
@@ -652,7 +615,6 @@ class Builder {
         sum += count;
       }
     }
-    PHASE("count");
     const std::size_t n_entries = bstart[nv];
     Scratch<BucketEntry> entries(n_entries);
     {
@@ -671,7 +633,6 @@ class Builder {
       }
     }
 
-    PHASE("fill");
     std::vector<std::uint32_t> twin(nc, kInv);
     std::vector<std::pair<std::uint32_t, std::uint32_t>> same_direction;  // pairs glued only after a flip
     std::vector<ComplexGroup> complex_groups;
@@ -720,7 +681,7 @@ class Builder {
         }
       };
       std::size_t mid = nv;
-      if (n_entries >= (std::size_t(1) << 16) && std::thread::hardware_concurrency() >= 2) {
+      if (n_entries >= kMinParallel && std::thread::hardware_concurrency() >= 2) {
         // Split the vertices where half the entries lie, so both threads get equal work.
         mid = static_cast<std::size_t>(std::upper_bound(bstart.begin(), bstart.end(), bstart[nv] / 2) - bstart.begin());
         mid = std::min(mid, nv);
@@ -735,7 +696,6 @@ class Builder {
       complex_groups = std::move(found[0].groups);
       complex_groups.insert(complex_groups.end(), found[1].groups.begin(), found[1].groups.end());
     }
-    PHASE("match");
     bstart = {};
     bstart.shrink_to_fit();
     report.non_manifold_edges = complex_groups.size();
@@ -814,7 +774,6 @@ class Builder {
     }
     entries.reset();
 
-    PHASE("orient+nm");
     // ---- 5. mesh corners: soup order minus skipped faces, flipped faces as c0, cn-1, .., c1 --
     const std::size_t nmf = nf - report.skipped_faces;
     const bool identity = !has_skipped && flipped.empty();
@@ -947,7 +906,6 @@ class Builder {
       }
     }
 
-    PHASE("corners+rep");
     // ---- 7. edges: a glued pair shares one edge, everything else gets an outer half ------
     Scratch<std::uint32_t> halfedge_of_corner(nmc);
     std::uint32_t ne = 0;
@@ -957,12 +915,10 @@ class Builder {
     }
     const std::uint32_t* H = halfedge_of_corner.get();
 
-    PHASE("edges");
     // ---- 8. connectivity of faces and boundary halves --------------------------------------
     Mesh& mesh = result_.mesh;
     mesh.resize(nv, ne, nmf);
     if (nv) std::memcpy(mesh.positions().data(), soup.positions.data(), nv * sizeof(Point));
-    PHASE("resize");
     std::vector<std::uint32_t> incoming(nv, kInv);  // one inner half-edge pointing to v
     parallel_ranges(nmf, [&](std::size_t fbegin, std::size_t fend) {
       for (std::size_t fi = fbegin; fi < fend; ++fi) {
@@ -980,13 +936,11 @@ class Builder {
         }
       }
     });
-    PHASE("records");
     // The lowest corner's: halfedge(v) of a closed fan is its opposite, as in build_local().
     for (std::uint32_t m = static_cast<std::uint32_t>(nmc); m-- > 0;) incoming[mvert[m]] = H[m];
     mtwin = {};
     mtwin.shrink_to_fit();
 
-    PHASE("incoming");
     // ---- 9. fans: one per vertex is the fast path; the others are split below ----------------
     // Rotating around v through inner half-edges pointing to v: across next(h) to the
     // neighbour face. Boundary halves are not linked yet, but their face is invalid.
@@ -1036,7 +990,6 @@ class Builder {
     split_vertices[0].insert(split_vertices[0].end(), split_vertices[1].begin(), split_vertices[1].end());
     const std::vector<std::uint32_t>& split = split_vertices[0];
 
-    PHASE("fanwalk");
     if (!split.empty()) {
       // Every fan after the first (ordered by lowest corner) becomes a copy of the vertex.
       std::vector<std::uint8_t> marked(nv, 0);
@@ -1104,7 +1057,6 @@ class Builder {
     for (std::size_t v = 0; v < nv; ++v)
       if (!uses[v]) ++report.isolated_vertices;
     halfedge_of_corner_ = std::move(halfedge_of_corner);
-    PHASE("split");
   }
 
   // Attributes, provenance, maps and messages: the same for both paths.
@@ -1171,7 +1123,6 @@ class Builder {
     }
     // Appending the copies grew the vertex arrays with slack.
     if (!copy_source_.empty()) mesh.shrink_to_fit();
-    PHASE("attributes");
 
     auto say = [&](std::string line) { report.messages.push_back(std::move(line)); };
     if (report.skipped_faces)
@@ -1215,10 +1166,6 @@ class Builder {
   Scratch<std::uint32_t> halfedge_of_corner_;  // mesh corner -> half-edge pointing to it
   std::vector<std::uint32_t> copy_source_;  // mesh vertex nv_ + i copies soup vertex copy_source_[i]
   std::size_t n_repeat_cuts_ = 0, n_glued_by_flip_ = 0;
-#ifdef HEDGE_BUILD_PROFILE
-  std::chrono::steady_clock::time_point phase_t0;
-  double phase_cpu0 = 0;
-#endif
 };
 
 }  // namespace
