@@ -219,6 +219,29 @@ TEST(Delaunay, SeamsStay) {
   }
 }
 
+TEST(Delaunay, FaceNormalsAreNotSeamsAndAreRecomputed) {
+  Mesh mesh = rhombus(-0.2f);  // slightly bent: the two face normals differ
+  ChannelArray* fn = mesh.face_properties().add_channel("normal", ScalarType::f32, 3);
+  for (Face f : mesh.faces()) {
+    const Halfedge h = mesh.halfedge(f);
+    const Point& a = mesh.position(mesh.to_vertex(h));
+    const Vec3f n = normalize(
+        cross(mesh.position(mesh.to_vertex(mesh.next(h))) - a, mesh.position(mesh.to_vertex(mesh.prev(h))) - a));
+    std::memcpy(fn->element(f.idx()), &n, sizeof n);
+  }
+  EXPECT_EQ(make_delaunay(mesh).flips, 1u);
+  fn = mesh.face_properties().get_channel("normal");
+  for (Face f : mesh.faces()) {
+    const Halfedge h = mesh.halfedge(f);
+    const Point& a = mesh.position(mesh.to_vertex(h));
+    const Vec3f want = normalize(
+        cross(mesh.position(mesh.to_vertex(mesh.next(h))) - a, mesh.position(mesh.to_vertex(mesh.prev(h))) - a));
+    Vec3f n;
+    std::memcpy(&n, fn->element(f.idx()), sizeof n);
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(n[k], want[k], 1e-6f);
+  }
+}
+
 TEST(Delaunay, ExistingDiagonalBlocksTheFlip) {
   // A tetrahedron's faces are all there: flipping any edge would duplicate another.
   Mesh mesh =

@@ -331,6 +331,29 @@ TEST(Smooth, KeepsConnectivityAndAttributes) {
             before.halfedge_properties().get_channel("uv")->bytes());
 }
 
+TEST(Smooth, RecomputesNormalChannels) {
+  Mesh mesh = sphere(3);
+  add_radial_noise(mesh, 0.03f);
+  ChannelArray* vn = mesh.vertex_properties().add_channel("normal", ScalarType::f32, 3);
+  ChannelArray* fn = mesh.face_properties().add_channel("normal", ScalarType::f32, 3);
+  smooth(mesh, method(SmoothingMethod::taubin, 10));
+  vn = mesh.vertex_properties().get_channel("normal");
+  fn = mesh.face_properties().get_channel("normal");
+  double worst = 1;
+  for (Vertex v : mesh.vertices()) {
+    Vec3f n;
+    std::memcpy(&n, vn->element(v.idx()), sizeof n);
+    EXPECT_NEAR(norm(n), 1.0f, 1e-5f);
+    worst = std::min(worst, double(dot(n, normalize(mesh.position(v)))));  // a smooth sphere: radial
+  }
+  EXPECT_GT(worst, 0.98);
+  for (Face f : mesh.faces()) {
+    Vec3f n;
+    std::memcpy(&n, fn->element(f.idx()), sizeof n);
+    EXPECT_NEAR(norm(n), 1.0f, 1e-5f);
+  }
+}
+
 TEST(Smooth, RefusalsAndCancellationLeaveTheMesh) {
   Mesh mesh = sphere(1);
   add_radial_noise(mesh, 0.05f);

@@ -438,6 +438,46 @@ TEST(Subdivide, Sqrt3CarriesCornersAndFaces) {
   EXPECT_EQ(n_flipped, 3u);  // the three children of face 3
 }
 
+TEST(Subdivide, RefreshesNormals) {
+  // Flat-shaded cube: corner normals are the face normals (hard edges). After Catmull-Clark
+  // each child corner keeps its parent face's normal; vertex normals are recomputed.
+  Mesh mesh = unit_cube();
+  ChannelArray* cn = mesh.halfedge_properties().add_channel("normal", ScalarType::f32, 3);
+  mesh.vertex_properties().add_channel("normal", ScalarType::f32, 3);
+  ChannelArray* material = mesh.face_properties().add_channel("material", ScalarType::i32, 1);
+  std::vector<Vec3f> parent_normal;
+  for (Face f : mesh.faces()) {
+    const std::int32_t id = std::int32_t(f.idx());
+    std::memcpy(material->element(f.idx()), &id, sizeof id);
+    Vec3f n{};
+    Halfedge h = mesh.halfedge(f);
+    const Point& a = mesh.position(mesh.to_vertex(h));
+    n = normalize(
+        cross(mesh.position(mesh.to_vertex(mesh.next(h))) - a, mesh.position(mesh.to_vertex(mesh.prev(h))) - a));
+    parent_normal.push_back(n);
+    for (Halfedge x : mesh.halfedges(f)) std::memcpy(cn->element(x.idx()), &n, sizeof n);
+  }
+  subdivide(mesh, scheme(SubdivisionScheme::catmull_clark));
+  cn = mesh.halfedge_properties().get_channel("normal");
+  ChannelArray* vn = mesh.vertex_properties().get_channel("normal");
+  material = mesh.face_properties().get_channel("material");
+  for (Face f : mesh.faces()) {
+    std::int32_t parent;
+    std::memcpy(&parent, material->element(f.idx()), sizeof parent);
+    for (Halfedge h : mesh.halfedges(f)) {
+      Vec3f n;
+      std::memcpy(&n, cn->element(h.idx()), sizeof n);
+      expect_point(n, to_double(parent_normal[std::size_t(parent)]), 1e-6);
+    }
+  }
+  for (Vertex v : mesh.vertices()) {
+    Vec3f n;
+    std::memcpy(&n, vn->element(v.idx()), sizeof n);
+    EXPECT_NEAR(norm(n), 1.0f, 1e-5f);
+    EXPECT_GT(dot(n, mesh.position(v) - Point{{0.5f, 0.5f, 0.5f}}), 0.0f);  // outward
+  }
+}
+
 TEST(Subdivide, RefusesPolygonsForTriangleSchemesAndLeavesTheMesh) {
   for (auto s : {SubdivisionScheme::loop, SubdivisionScheme::sqrt3}) {
     Mesh mesh = unit_cube();

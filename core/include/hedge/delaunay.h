@@ -56,10 +56,11 @@ DelaunayCensus delaunay_census(const Mesh& mesh, const DelaunayOptions& options 
 //! surfaces a budget of flip_budget_per_edge × edges stops it, and the report says so.
 //!
 //! Never flipped: boundary edges, features (dihedral above feature_angle), seams (corner
-//! attributes such as UVs that differ on the two sides at either end vertex, or face
-//! attributes that differ between the two faces), flips is_flip_ok refuses, and flips whose
-//! new edge would be a feature or turn a triangle over. Attributes: the flip keeps each face
-//! with its face attributes and moves corner attributes with their corners (Mesh::flip).
+//! attributes such as UVs or hard-edge normals that differ on the two sides at either end
+//! vertex, or face attributes other than "normal" and "quality" that differ between the two
+//! faces), flips is_flip_ok refuses, and flips whose new edge would be a feature or turn a
+//! triangle over. Attributes: the flip keeps each face with its face attributes and moves corner
+//! attributes with their corners (Mesh::flip); face "normal" channels are recomputed.
 //!
 //! Throws Error, leaving the mesh untouched, when the mesh has faces other than triangles;
 //! Cancelled through progress likewise (the flips run on a copy).

@@ -42,7 +42,8 @@ struct SmoothReport {
 
 //! Smooths the positions in `options.iterations` Jacobi steps (all vertices move at once, from
 //! the previous step's positions). Connectivity and every property stay as they are; only
-//! positions change (host normals become stale: hosts recompute them).
+//! positions change, and the vertex and face "normal" channels, recomputed from the new shape
+//! (corner normals are kept: they may carry hard edges).
 //!
 //! Cotangent weights are recomputed every step from the current shape, per edge
 //! (cot α + cot β) / 2 with each cotangent clamped to ±cot(3°) and negative edge weights set

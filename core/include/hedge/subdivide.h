@@ -52,7 +52,9 @@ std::size_t subdivided_face_count(const Mesh& mesh, const SubdivideOptions& opti
 //! linearly inside each old face (midpoints, centroids), so seams stay seams; face
 //! properties are copied to the child faces; edge properties are copied to the two halves of
 //! a split edge. The mesh's own "hedge:" bookkeeping is copied for continuing elements and
-//! left at its default for new ones (a new vertex has no source vertex).
+//! left at its default for new ones (a new vertex has no source vertex). "normal" channels
+//! are refreshed: vertex and face normals recomputed from the refined shape, corner normals
+//! (blended per face, so hard edges stay hard) scaled back to unit length.
 //!
 //! Numbering (on a mesh without deleted elements): old vertices keep their indices; loop,
 //! catmull_clark and midpoint put the point of edge e at vertex V + e and face points after

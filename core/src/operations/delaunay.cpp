@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "hedge/error.h"
+#include "hedge/normals.h"
 
 namespace hedge {
 namespace {
@@ -56,8 +57,13 @@ struct Seams {
   explicit Seams(const Mesh& m) {
     for (std::size_t i = 0; i < m.halfedge_properties().count(); ++i)
       if (auto* c = m.halfedge_properties().get_channel(m.halfedge_properties().at(i).name())) corners.push_back(c);
-    for (std::size_t i = 0; i < m.face_properties().count(); ++i)
-      if (auto* c = m.face_properties().get_channel(m.face_properties().at(i).name())) faces.push_back(c);
+    // Face channels label regions (materials, selections, colours), except measured values
+    // that differ between any two faces of a curved surface.
+    for (std::size_t i = 0; i < m.face_properties().count(); ++i) {
+      const std::string& name = m.face_properties().at(i).name();
+      if (name == "normal" || name == "quality") continue;
+      if (auto* c = m.face_properties().get_channel(name)) faces.push_back(c);
+    }
     flipped = m.face_properties().get<bool>("hedge:flipped");
   }
 
@@ -97,6 +103,20 @@ Verdict judge(const Mesh& m, Edge e, const DelaunayOptions& o, const Seams& seam
 
 bool is_interior_triangle_edge(const Mesh& m, Edge e) {
   return !m.is_boundary(e) && is_triangle(m, Mesh::halfedge(e, 0)) && is_triangle(m, Mesh::halfedge(e, 1));
+}
+
+//! Positions changed: the "normal" channels (float x3) of vertices and faces are recomputed
+//! from the new shape, so hosts do not show stale shading.
+void refresh_normal_channels(Mesh& mesh, bool vertices, bool faces) {
+  auto fill = [](ChannelArray* c, const std::vector<Vec3f>& normals) {
+    if (!c || c->scalar() != ScalarType::f32 || c->components() != 3) return;
+    for (std::size_t i = 0; i < normals.size() && i < c->size(); ++i)
+      std::memcpy(c->element(i), &normals[i], sizeof(Vec3f));
+  };
+  if (vertices)
+    if (ChannelArray* c = mesh.vertex_properties().get_channel("normal")) fill(c, vertex_normals(mesh));
+  if (faces)
+    if (ChannelArray* c = mesh.face_properties().get_channel("normal")) fill(c, face_normals(mesh));
 }
 
 }  // namespace
@@ -193,6 +213,7 @@ DelaunayReport make_delaunay(Mesh& mesh, const DelaunayOptions& options, Progres
   progress.update(0.95, "checking edges");
   report.after = delaunay_census(work, options);
   mesh = std::move(work);
+  if (report.flips) refresh_normal_channels(mesh, false, true);  // flipped faces have new shapes
   return report;
 }
 
@@ -207,7 +228,8 @@ Operation make_delaunay_operation() {
       "surface. Triangle meshes only (run Triangulate first). Never flipped: boundary edges; feature edges, whose "
       "two triangles meet at a dihedral angle above feature_angle (0 = only flat regions change, 180 = ignore "
       "features); flips whose new edge would itself be a feature or turn a triangle over; seams, where UVs or "
-      "other corner attributes, or face attributes such as materials, differ across the edge; flips that would "
+      "other corner attributes (hard-edge normals), or face attributes such as materials, differ across the edge; "
+      "flips that would "
       "duplicate an existing edge. On curved surfaces flipping stops after 50 flips per edge and the report says "
       "so. Vertices, faces and their attributes are kept; corner attributes move with their corners. The report "
       "counts flips and the edges left non-Delaunay, by reason.";

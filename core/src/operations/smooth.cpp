@@ -4,12 +4,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <exception>
 #include <numbers>
 #include <thread>
 #include <vector>
 
 #include "hedge/error.h"
+#include "hedge/normals.h"
 
 namespace hedge {
 namespace {
@@ -114,6 +116,20 @@ void cotangent_weights(const Mesh& m, const std::vector<Vec3d>& p, const std::ve
       weight[e] = std::max(0.0, w);
     }
   });
+}
+
+//! Positions changed: the "normal" channels (float x3) of vertices and faces are recomputed
+//! from the new shape, so hosts do not show stale shading.
+void refresh_normal_channels(Mesh& mesh, bool vertices, bool faces) {
+  auto fill = [](ChannelArray* c, const std::vector<Vec3f>& normals) {
+    if (!c || c->scalar() != ScalarType::f32 || c->components() != 3) return;
+    for (std::size_t i = 0; i < normals.size() && i < c->size(); ++i)
+      std::memcpy(c->element(i), &normals[i], sizeof(Vec3f));
+  };
+  if (vertices)
+    if (ChannelArray* c = mesh.vertex_properties().get_channel("normal")) fill(c, vertex_normals(mesh));
+  if (faces)
+    if (ChannelArray* c = mesh.face_properties().get_channel("normal")) fill(c, face_normals(mesh));
 }
 
 }  // namespace
@@ -245,6 +261,7 @@ SmoothReport smooth(Mesh& mesh, const SmoothOptions& options, Progress& progress
   }
   report.mean_displacement = count ? sum / count : 0;
   for (Index v = 0; v < V; ++v) mesh.positions()[v] = to_float(current[v]);
+  refresh_normal_channels(mesh, true, true);
   return report;
 }
 
@@ -261,7 +278,8 @@ Operation smooth_operation() {
       "by an inflating μ step, μ = -λ / (1 - 0.1 λ); smooths noise while keeping the volume; strengths above "
       "0.68 are limited to keep it stable). Strength is λ, the fraction of the way to the mean per step. With "
       "preserve_boundary, boundary vertices stay fixed; otherwise they are smoothed along their boundary curve. "
-      "Only positions change: every attribute and the connectivity are kept (hosts recompute normals).";
+      "Only positions change: the connectivity and every attribute are kept, except vertex and face normals, which "
+      "are recomputed from the new shape.";
   op.params = {
       ParamSpec::choice("method", "Method", {"uniform", "cotangent", "taubin"}, 0,
                         "uniform is fastest but shrinks; cotangent follows the surface; taubin keeps the volume"),

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "hedge/error.h"
+#include "hedge/normals.h"
 
 namespace hedge {
 namespace {
@@ -743,6 +744,32 @@ FaceCensus face_census(const Mesh& mesh) {
   return c;
 }
 
+//! Positions changed: the "normal" channels (float x3) of vertices and faces are recomputed
+//! from the new shape, so hosts do not show stale shading.
+void refresh_normal_channels(Mesh& mesh, bool vertices, bool faces) {
+  auto fill = [](ChannelArray* c, const std::vector<Vec3f>& normals) {
+    if (!c || c->scalar() != ScalarType::f32 || c->components() != 3) return;
+    for (std::size_t i = 0; i < normals.size() && i < c->size(); ++i)
+      std::memcpy(c->element(i), &normals[i], sizeof(Vec3f));
+  };
+  if (vertices)
+    if (ChannelArray* c = mesh.vertex_properties().get_channel("normal")) fill(c, vertex_normals(mesh));
+  if (faces)
+    if (ChannelArray* c = mesh.face_properties().get_channel("normal")) fill(c, face_normals(mesh));
+}
+
+//! Corner normals were blended inside each face (hard edges stay hard): back to unit length.
+void normalize_corner_normals(Mesh& mesh) {
+  ChannelArray* c = mesh.halfedge_properties().get_channel("normal");
+  if (!c || c->scalar() != ScalarType::f32 || c->components() != 3) return;
+  for (std::size_t i = 0; i < c->size(); ++i) {
+    Vec3f n;
+    std::memcpy(&n, c->element(i), sizeof n);
+    n = normalize(n);
+    std::memcpy(c->element(i), &n, sizeof n);
+  }
+}
+
 std::size_t forecast_faces(const FaceCensus& c, const SubdivideOptions& options) {
   if (options.iterations <= 0 || c.faces == 0) return c.faces;
   // Doubles, so that absurd requests compare as huge instead of wrapping around.
@@ -831,6 +858,8 @@ SubdivideReport subdivide(Mesh& mesh, const SubdivideOptions& options, Progress&
     current = &result;
   }
   mesh = std::move(result);
+  refresh_normal_channels(mesh, true, true);
+  normalize_corner_normals(mesh);
 
   SubdivideReport report;
   report.vertices = mesh.n_vertices();
@@ -854,7 +883,8 @@ Operation subdivide_operation() {
       "loop and sqrt3 refuse meshes with polygons: run Triangulate first. Boundaries: loop and catmull_clark "
       "refine boundary curves with the cubic B-spline rule; sqrt3 keeps boundary edges and vertices fixed. "
       "Attributes: vertex attributes are blended with the scheme's own weights, corner attributes (UVs) linearly "
-      "inside each old face so seams stay seams, face attributes (materials) are copied to the child faces. "
+      "inside each old face so seams stay seams, face attributes (materials) are copied to the child faces; normals "
+      "are recomputed for the new shape. "
       "Results above 200 million faces are refused before starting.";
   op.params = {
       ParamSpec::choice("scheme", "Scheme", {"loop", "catmull_clark", "sqrt3", "midpoint"}, 0,
