@@ -1,7 +1,6 @@
 // Euler operations of Mesh: adding faces, filling holes, flips, splits, edge insertion and
 // removal, collapses and triangulation. Each keeps every invariant listed in mesh.h.
 #include <algorithm>
-#include <cassert>
 #include <string>
 #include <utility>
 #include <vector>

@@ -759,6 +759,17 @@ TEST(Euler, InsertEdgeSplitsPolygons) {
   ASSERT_VALID(m);
   EXPECT_EQ(m.n_faces(), 3u);
   EXPECT_EQ(m.valence(g), 3u);
+
+  // Inside a closed mesh: a diagonal across a cube face.
+  Mesh c = cube();
+  Halfedge c0 = c.halfedge(Face(2));
+  Halfedge diag = c.insert_edge(c0, c.next(c.next(c0)));
+  ASSERT_VALID(c);
+  EXPECT_EQ(c.n_faces(), 7u);
+  EXPECT_EQ(c.n_edges(), 13u);
+  EXPECT_EQ(c.valence(Face(2)), 3u);
+  EXPECT_EQ(c.valence(c.face(Mesh::opposite(diag))), 3u);
+  EXPECT_EQ(boundary_loops(c), 0u);
 }
 
 TEST(Euler, InsertEdgeRefusals) {
@@ -813,6 +824,19 @@ TEST(Euler, RemoveEdgeMergesPolygons) {
   ASSERT_VALID(m);
   EXPECT_EQ(m.edges_size(), 6u);
   EXPECT_EQ(m.faces_size(), 1u);
+
+  // Inside a closed mesh: two cube faces become one hexagon.
+  Mesh c = cube();
+  Edge ce = c.find_edge(Vertex(0), Vertex(1));
+  ASSERT_TRUE(c.is_removal_ok(ce));
+  c.remove_edge(ce);
+  ASSERT_VALID(c);
+  EXPECT_EQ(c.n_faces(), 5u);
+  EXPECT_EQ(c.n_edges(), 11u);
+  std::size_t hexagons = 0;
+  for (Face f : c.faces()) hexagons += c.valence(f) == 6;
+  EXPECT_EQ(hexagons, 1u);
+  EXPECT_EQ(c.valence(Vertex(0)), 2u);
 
   // insert_edge then remove_edge gives the polygon back, corner order included.
   Mesh p = polygon(7);
