@@ -265,6 +265,7 @@ class Decimator {
   };
   mutable std::vector<RingEntry> ring0_, ring1_;  // scratch of is_legal()
   mutable int refusal_ = 0;  // which test refused the last collapse (for debugging)
+  mutable double worst_new_ = 1, worst_old_ = 1;  // triangle quality around the collapse being tested
 
   std::vector<ChannelArray*> corner_channels_;  // host per-corner channels (seams are judged on these)
   // Vertex properties with their fast path resolved once.
@@ -555,8 +556,8 @@ bool Decimator::triangle_ok(const Vec3d& old_apex, const Vec3d& new_apex, const 
     if (old_sq > 0 && dot(n_old, n_new) < cos_max_normal_change_ * std::sqrt(old_sq * new_sq)) return false;
   }
   if (opt_.min_quality > 0) {
-    const double q_new = triangle_quality(new_apex, a, b);
-    if (q_new < opt_.min_quality && q_new < triangle_quality(old_apex, a, b)) return false;
+    worst_new_ = std::min(worst_new_, triangle_quality(new_apex, a, b));
+    worst_old_ = std::min(worst_old_, triangle_quality(old_apex, a, b));
   }
   return true;
 }
@@ -609,8 +610,17 @@ bool Decimator::is_legal(Halfedge h, const Point& target) const {
     for (const RingEntry& r0 : ring0_)
       if (r0.vertex == r1.vertex) { refusal_ = 12; return false; }
   }
-  // Every triangle that stays, around either end, with its apex moved to the target.
+  // Every triangle that stays, around either end, with its apex moved to the target. Quality
+  // is judged over the whole neighbourhood (pmp's rule): a collapse may not make its worst
+  // triangle worse than both the threshold and the worst triangle it replaces, so slivers of
+  // the input do not freeze the regions around them.
   const Vec3d p_new = to_double(target);
+  worst_new_ = worst_old_ = 1;
+  if (opt_.min_quality > 0) {
+    const Vec3d p0 = to_double(m_.position(v0)), p1 = to_double(m_.position(v1));
+    if (vl.is_valid()) worst_old_ = std::min(worst_old_, triangle_quality(p0, p1, to_double(m_.position(vl))));
+    if (vr.is_valid()) worst_old_ = std::min(worst_old_, triangle_quality(p1, p0, to_double(m_.position(vr))));
+  }
   auto faces_ok = [&](Vertex v, std::vector<RingEntry>& ring) {
     for (RingEntry& r : ring) r.position = to_double(m_.position(r.vertex));
     const Vec3d apex = to_double(m_.position(v));
@@ -624,6 +634,7 @@ bool Decimator::is_legal(Halfedge h, const Point& target) const {
   };
   if (!faces_ok(v0, ring0_)) { refusal_ = 11; return false; }
   if (!faces_ok(v1, ring1_)) { refusal_ = 13; return false; }
+  if (worst_new_ < opt_.min_quality && worst_new_ < worst_old_) { refusal_ = 14; return false; }
   return true;
 }
 
