@@ -142,7 +142,12 @@ void PropertyContainer::copy_element(std::size_t from, std::size_t to) {
   for (auto& p : arrays_) p->copy_element(from, to);
 }
 void PropertyContainer::interpolate(std::size_t to, std::span<const Index> from, std::span<const float> weights) {
-  for (auto& p : arrays_) p->interpolate(to, from, weights);
+  for (auto& p : arrays_) {
+    if (p->is_internal())
+      p->reset(to);
+    else
+      p->interpolate(to, from, weights);
+  }
 }
 void PropertyContainer::permute(std::span<const Index> new_to_old) {
   for (auto& p : arrays_) p->permute(new_to_old);

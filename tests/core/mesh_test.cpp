@@ -176,6 +176,21 @@ TEST(Mesh, InterpolateNumbersAndPickOthers) {
   EXPECT_EQ(id[Vertex(2)], 20);  // integers take the heaviest source
 }
 
+TEST(Mesh, InterpolationDoesNotInheritProvenance) {
+  Mesh m;
+  for (int i = 0; i < 3; ++i) m.add_vertex(Point{{float(i), 0, 0}});
+  auto source = m.add_vertex_property<std::uint32_t>("hedge:source", kInvalidIndex);
+  source[Vertex(0)] = 0;
+  source[Vertex(1)] = 0;
+  source[Vertex(2)] = 2;
+  std::vector<Index> from = {0, 1};
+  std::vector<float> weights = {0.5f, 0.5f};
+  m.vertex_properties().interpolate(2, from, weights);
+  EXPECT_EQ(source[Vertex(2)], kInvalidIndex);  // a new vertex has no source of its own
+  m.vertex_properties().copy_element(0, 2);
+  EXPECT_EQ(source[Vertex(2)], 0u);  // a copy shares its source
+}
+
 TEST(Mesh, DeleteFaceAndGarbageCollect) {
   Mesh m = quad_grid();
   auto tag = m.add_vertex_property<int>("tag");

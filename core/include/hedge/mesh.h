@@ -280,7 +280,9 @@ class Mesh {
   bool is_deleted(Face f) const { return deleted_faces_ && fdeleted_[f.idx()]; }
   bool has_garbage() const { return deleted_vertices_ || deleted_edges_ || deleted_faces_; }
   //! Removes f; its edges that end up with no face on either side are deleted too, and
-  //! vertices left without edges are deleted (pmp semantics).
+  //! vertices left without edges are deleted (pmp semantics). A vertex whose fan this
+  //! leaves with two gaps is non-manifold (validate() says so): callers that delete
+  //! several faces around a vertex must rebuild or repair it.
   void delete_face(Face f);
   //! Removes the faces on both sides of e, then as delete_face().
   void delete_edge(Edge e);

@@ -31,6 +31,9 @@ class PropertyArray {
   explicit PropertyArray(std::string name) : name_(std::move(name)) {}
   virtual ~PropertyArray() = default;
   const std::string& name() const { return name_; }
+  //! build()'s provenance ("hedge:source", "hedge:flipped", ...): bookkeeping about where an
+  //! element came from, which a new element made from several old ones does not inherit.
+  bool is_internal() const { return name_.starts_with("hedge:"); }
 
   virtual std::size_t size() const = 0;
   virtual void resize(std::size_t n) = 0;
@@ -41,6 +44,8 @@ class PropertyArray {
   virtual void copy_element(std::size_t from, std::size_t to) = 0;
   //! element[to] = sum w_i element[from_i] for numbers; the value of the largest weight otherwise.
   virtual void interpolate(std::size_t to, std::span<const Index> from, std::span<const float> weights) = 0;
+  //! element[i] = the default value (zeros for channels).
+  virtual void reset(std::size_t i) = 0;
   //! Gather: new[i] = old[new_to_old[i]]; the size becomes new_to_old.size().
   virtual void permute(std::span<const Index> new_to_old) = 0;
   virtual std::unique_ptr<PropertyArray> clone() const = 0;
@@ -104,6 +109,7 @@ class TypedArray final : public PropertyArray {
       data_[to] = T(data_[from[detail::largest_weight(weights)]]);
     }
   }
+  void reset(std::size_t i) override { data_[i] = default_; }
   void permute(std::span<const Index> new_to_old) override {
     std::vector<T> out;
     out.reserve(new_to_old.size());
@@ -150,6 +156,7 @@ class ChannelArray final : public PropertyArray {
     if (from != to) std::memcpy(element(to), element(from), stride_);
   }
   void interpolate(std::size_t to, std::span<const Index> from, std::span<const float> weights) override;
+  void reset(std::size_t i) override { std::memset(element(i), 0, stride_); }
   void permute(std::span<const Index> new_to_old) override;
   std::unique_ptr<PropertyArray> clone() const override { return std::make_unique<ChannelArray>(*this); }
   const std::type_info& type() const override { return typeid(ChannelArray); }
@@ -234,6 +241,7 @@ class PropertyContainer {
   void shrink_to_fit();
   void swap_elements(std::size_t a, std::size_t b);
   void copy_element(std::size_t from, std::size_t to);
+  //! Interpolates every array, except internal ones, which take their default.
   void interpolate(std::size_t to, std::span<const Index> from, std::span<const float> weights);
   void permute(std::span<const Index> new_to_old);
   std::size_t heap_bytes() const;
