@@ -506,6 +506,18 @@ TEST(Build, ChannelsOfACleanMeshRoundTrip) {
   EXPECT_EQ(n_properties(r.mesh), soup.channels.size());  // no provenance
 }
 
+TEST(Build, ExtractGroupsChannelsByDomain) {
+  // A soup listing a corner channel before a vertex channel gets them back vertex first;
+  // each channel is unchanged.
+  Soup soup = grid(2, 2);
+  soup.add_channel("uv", Domain::corner, ScalarType::f32, 2).data[5] = std::byte{9};
+  soup.add_channel("quality", Domain::vertex, ScalarType::f32, 1).data[3] = std::byte{7};
+  const Soup out = extract(build(soup).mesh);
+  ASSERT_EQ(out.channels.size(), 2u);
+  EXPECT_EQ(out.channels[0], soup.channels[1]);
+  EXPECT_EQ(out.channels[1], soup.channels[0]);
+}
+
 TEST(Build, ExtractWithoutRestoringKeepsTheCopies) {
   Soup soup = make_soup(5, {{0, 1, 2}, {0, 3, 4}, {0, 1, 3}});
   BuildResult r = build(soup);
