@@ -1,0 +1,156 @@
+# The batch API and the work shared with the operators: which meshes to process, reading
+# them (Object Mode data or the edit mesh), running an operation, writing the results back
+# only once every mesh succeeded.
+#
+#   import hedge
+#   report = hedge.run(bpy.data.objects["dragon"], "decimate", target_ratio=0.1)
+import bmesh
+import bpy
+
+from . import exchange
+from .native import native, Error, Cancelled, require_native
+
+# The last report of each operation and of each object's Mesh Report, for the panel, and
+# the parameters of each operation's last run (after Blender's property limits).
+last_reports = {}
+last_params = {}
+
+
+def catalogue():
+    """Every operation as a dict (id, title, category, help, changes_mesh, params)."""
+    return require_native().catalogue()
+
+
+def operation(op_id):
+    for op in catalogue():
+        if op["id"] == op_id:
+            return op
+    raise Error(f"unknown operation '{op_id}'; the operations are: " + ", ".join(o["id"] for o in catalogue()))
+
+
+class Target:
+    """One mesh to process: an object in Object Mode, or one in Edit Mode (its edit mesh)."""
+
+    def __init__(self, obj):
+        if obj is None or obj.type != 'MESH':
+            raise Error(f"{getattr(obj, 'name', obj)!r} is not a mesh object")
+        self.obj = obj
+        self.edit = obj.mode == 'EDIT'
+        self.scratch = None
+        self.data = None
+        self.result = None
+        self.report = None
+
+    def read(self):
+        me = self.obj.data
+        if self.edit:
+            # The edit mesh is the truth in Edit Mode: work on a copy, load it back after.
+            self.scratch = bpy.data.meshes.new("hedge scratch")
+            bmesh.from_edit_mesh(me).to_mesh(self.scratch)
+            me = self.scratch
+        self.data = exchange.read_mesh(me)
+        return self.data.soup
+
+    def check_writable(self, op):
+        """Refuses, before anything is written, what the exchange cannot keep consistent."""
+        if self.result is None or exchange.same_topology(self.data.soup, self.result):
+            return
+        if self.obj.data.shape_keys is not None:
+            raise Error(f"{self.obj.name} has shape keys, which cannot follow {op['title']} (it changes the "
+                        f"vertices); apply or remove them first")
+
+    def write(self):
+        if self.result is not None:
+            if self.edit:
+                exchange.write_mesh(self.scratch, self.data, self.result)
+                bm = bmesh.from_edit_mesh(self.obj.data)
+                bm.clear()
+                bm.from_mesh(self.scratch)
+                bmesh.update_edit_mesh(self.obj.data, loop_triangles=True, destructive=True)
+            else:
+                exchange.write_mesh(self.obj.data, self.data, self.result)
+                self.obj.data.update()
+        self.release()
+
+    def release(self):
+        if self.scratch is not None:
+            bpy.data.meshes.remove(self.scratch)
+            self.scratch = None
+
+
+def targets(context):
+    """The meshes an operator works on: every selected mesh object in Object Mode (each
+    mesh once, even when objects share it), the objects in Edit Mode otherwise."""
+    if context.mode == 'EDIT_MESH':
+        objects = list(getattr(context, "objects_in_mode", None) or [context.edit_object])
+    else:
+        objects = [o for o in (context.selected_objects or []) if o.type == 'MESH']
+    seen, out = set(), []
+    for obj in objects:
+        if obj is not None and obj.type == 'MESH' and obj.data.name_full not in seen:
+            seen.add(obj.data.name_full)
+            out.append(obj)
+    return out
+
+
+def summary(op, report):
+    """One line for the info area."""
+    parts = []
+    for key in ("faces_before", "faces_after", "faces", "vertices", "holes", "boundary_loops", "seconds"):
+        if key in report:
+            value = report[key]
+            parts.append(f"{key.replace('_', ' ')} {value:.3g}" if isinstance(value, float) else f"{key.replace('_', ' ')} {value}")
+    return f"Hedge {op['title']}: " + (", ".join(parts) if parts else "done")
+
+
+def run_targets(op_id, target_list, params, progress=None):
+    """Runs one operation on several targets; writes nothing unless every one succeeded."""
+    op = operation(op_id)
+    native_module = require_native()
+    last_params[op_id] = dict(params)
+    n = len(target_list)
+    try:
+        for i, t in enumerate(target_list):
+            soup = t.read()
+            step = None
+            if progress is not None:
+                def step(fraction, stage, i=i):
+                    return progress((i + fraction) / n, stage)
+            t.result, t.report = native_module.run(op_id, soup, dict(params), step)
+            t.report["object"] = t.obj.name
+        for t in target_list:
+            t.check_writable(op)
+    except BaseException:
+        for t in target_list:
+            t.release()
+        raise
+    for t in target_list:
+        t.write()
+        remember(op, t.obj, t.report)
+    return [t.report for t in target_list]
+
+
+def remember(op, obj, report):
+    last_reports[op["id"]] = report
+    if not op["changes_mesh"]:
+        last_reports["report:" + obj.name] = report
+
+
+def run(obj, op_id, progress=None, **params):
+    """Runs operation `op_id` on a mesh object (its edit mesh in Edit Mode) with the given
+    parameters (catalogue ids; others take their defaults) and returns the report dict.
+    Raises hedge.Error with a message for people; the mesh is then unchanged."""
+    return run_targets(op_id, [Target(obj)], params, progress)[0]
+
+
+def import_file(path, name=None):
+    """Reads a mesh file (OFF, OBJ, PLY, STL) with hedge's reader into a new object linked to
+    the active collection, and returns the object."""
+    import os
+    soup = require_native().read_mesh(path)
+    name = name or os.path.splitext(os.path.basename(path))[0]
+    me = bpy.data.meshes.new(name)
+    exchange.write_new(me, soup)
+    obj = bpy.data.objects.new(name, me)
+    bpy.context.collection.objects.link(obj)
+    return obj

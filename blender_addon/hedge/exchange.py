@@ -1,0 +1,332 @@
+# bpy.types.Mesh <-> the native module's mesh dict (hedge's Soup), through numpy only:
+# foreach_get/foreach_set on float32/int32 buffers, no per-element Python loops.
+#
+# What crosses, and under which channel name (docs/decisions.md, "Blender add-on"):
+#   vertex positions             positions
+#   polygons of any size         face_sizes, corners (in loop order)
+#   each UV map                  corner "uv:<map name>"     f32 x2
+#   each colour attribute        "color:<name>"             f32 x4 (byte colours as sRGB /255)
+#   generic attributes           "attr:<name>"              point, face or corner domain
+#   material indices             face "material"            i32
+#   smooth shading               face "smooth"              u8
+#   selection, hiding            "selected", "hidden"       u8, vertex and face
+#   vertex bevel weight          vertex "bevel_weight"      f32
+#   vertex identity              vertex "blender:vertex"    i32 (where each result vertex came from)
+# Edge data (seams, sharp edges, creases, bevel weights, generic edge attributes) has no
+# channel: it is matched back by the pair of source vertices of each result edge.
+import numpy as np
+
+# Blender attribute type -> (foreach property, numpy dtype, components)
+ATTRIBUTE_TYPES = {
+    'FLOAT': ("value", np.float32, 1),
+    'INT': ("value", np.int32, 1),
+    'FLOAT_VECTOR': ("vector", np.float32, 3),
+    'FLOAT2': ("vector", np.float32, 2),
+    'FLOAT_COLOR': ("color", np.float32, 4),
+    'BYTE_COLOR': ("color_srgb", np.float32, 4),
+    'BOOLEAN': ("value", np.bool_, 1),
+    'INT8': ("value", np.int8, 1),
+}
+DOMAINS = {'POINT': "vertex", 'FACE': "face", 'CORNER': "corner"}
+BLENDER_DOMAINS = {v: k for k, v in DOMAINS.items()}
+# Attributes that the mesh API owns under another name (3.4 and later versions).
+RESERVED = {"position", "material_index", "sharp_face", ".corner_vert", ".corner_edge", ".edge_verts"}
+
+EDGE_FLAGS = (("use_seam", np.bool_), ("use_edge_sharp", np.bool_), ("use_freestyle_mark", np.bool_))
+
+
+def _get(collection, prop, n, dtype, components=1):
+    out = np.empty(n * components, dtype)
+    if n:
+        collection.foreach_get(prop, out)
+    return out.reshape(n, components) if components > 1 else out
+
+
+def _set(collection, prop, values):
+    if len(collection):
+        collection.foreach_set(prop, np.ascontiguousarray(values).ravel())
+
+
+class MeshData:
+    """One mesh read from Blender: the dict the native module takes, and what is needed to
+    write a result back (names of layers and attributes, edge data keyed by vertex pair)."""
+
+    def __init__(self):
+        self.soup = None          # dict: positions, face_sizes, corners, channels
+        self.loop_order = None    # corner -> loop index when loops are not in polygon order
+        self.uv_names = []
+        self.active_uv = None
+        self.render_uv = None
+        self.colors = []          # (name, data_type, domain)
+        self.active_color = None
+        self.render_color = None
+        self.attributes = []      # (name, data_type, domain) generic point/face/corner
+        self.edges = None         # (n, 2) int32 vertex pairs
+        self.edge_data = {}       # name -> array per edge (flags, crease, bevel weight)
+        self.edge_attributes = [] # (name, data_type) generic edge attributes, values in edge_data
+        self.not_carried = []     # what could not cross, for the report
+
+
+def read_mesh(me):
+    """Reads a bpy.types.Mesh (object mode data) into a MeshData."""
+    d = MeshData()
+    nv, nl, nf, ne = len(me.vertices), len(me.loops), len(me.polygons), len(me.edges)
+    positions = _get(me.vertices, "co", nv, np.float32, 3)
+    loop_total = _get(me.polygons, "loop_total", nf, np.int32)
+    loop_start = _get(me.polygons, "loop_start", nf, np.int32)
+    vertex_index = _get(me.loops, "vertex_index", nl, np.int32)
+    starts = np.zeros(nf, np.int64)
+    if nf:
+        np.cumsum(loop_total[:-1], out=starts[1:])
+    if nf and not np.array_equal(starts, loop_start):
+        # Loops not stored in polygon order: corner k of polygon f is loop loop_start[f] + k.
+        d.loop_order = (np.repeat(loop_start - starts, loop_total) + np.arange(int(loop_total.sum()))).astype(np.int64)
+        corners = vertex_index[d.loop_order]
+    else:
+        corners = vertex_index
+    channels = []
+
+    def corner_values(values):
+        return values if d.loop_order is None else values[d.loop_order]
+
+    for layer in me.uv_layers:
+        channels.append(("uv:" + layer.name, "corner", corner_values(_get(layer.data, "uv", nl, np.float32, 2))))
+        d.uv_names.append(layer.name)
+    if me.uv_layers.active is not None:
+        d.active_uv = me.uv_layers.active.name
+    for layer in me.uv_layers:
+        if layer.active_render:
+            d.render_uv = layer.name
+
+    color_names = set()
+    for attr in me.color_attributes:
+        color_names.add(attr.name)
+    if me.color_attributes.active_color is not None:
+        d.active_color = me.color_attributes.active_color.name
+    try:
+        d.render_color = me.color_attributes[me.color_attributes.render_color_index].name
+    except (IndexError, AttributeError):
+        d.render_color = None
+
+    sizes = {"vertex": nv, "face": nf, "corner": nl}
+    for attr in me.attributes:
+        name = attr.name
+        if name.startswith(".") or name in RESERVED or name in d.uv_names:
+            continue
+        kind = ATTRIBUTE_TYPES.get(attr.data_type)
+        if kind is None:
+            d.not_carried.append(f"attribute {name} ({attr.data_type})")
+            continue
+        prop, dtype, comps = kind
+        if attr.domain == 'EDGE':
+            d.edge_attributes.append((name, attr.data_type))
+            d.edge_data["attr:" + name] = _get(attr.data, prop, ne, dtype, comps)
+            continue
+        domain = DOMAINS.get(attr.domain)
+        if domain is None:
+            d.not_carried.append(f"attribute {name} ({attr.domain})")
+            continue
+        values = _get(attr.data, prop, sizes[domain], dtype, comps)
+        if dtype == np.bool_:
+            values = values.view(np.uint8)
+        if domain == "corner":
+            values = corner_values(values)
+        if name in color_names:
+            channels.append(("color:" + name, domain, values))
+            d.colors.append((name, attr.data_type, attr.domain))
+        else:
+            channels.append(("attr:" + name, domain, values))
+            d.attributes.append((name, attr.data_type, attr.domain))
+
+    channels.append(("material", "face", _get(me.polygons, "material_index", nf, np.int32)))
+    channels.append(("smooth", "face", _get(me.polygons, "use_smooth", nf, np.bool_).view(np.uint8)))
+    channels.append(("selected", "vertex", _get(me.vertices, "select", nv, np.bool_).view(np.uint8)))
+    channels.append(("selected", "face", _get(me.polygons, "select", nf, np.bool_).view(np.uint8)))
+    channels.append(("hidden", "vertex", _get(me.vertices, "hide", nv, np.bool_).view(np.uint8)))
+    channels.append(("hidden", "face", _get(me.polygons, "hide", nf, np.bool_).view(np.uint8)))
+    if me.has_bevel_weight_vertex:
+        channels.append(("bevel_weight", "vertex", _get(me.vertices, "bevel_weight", nv, np.float32)))
+    channels.append(("blender:vertex", "vertex", np.arange(nv, dtype=np.int32)))
+
+    d.edges = _get(me.edges, "vertices", ne, np.int32, 2)
+    for prop, dtype in EDGE_FLAGS:
+        values = _get(me.edges, prop, ne, dtype)
+        if values.any():
+            d.edge_data[prop] = values
+    if me.has_crease_edge:
+        d.edge_data["crease"] = _get(me.edges, "crease", ne, np.float32)
+    if me.has_bevel_weight_edge:
+        d.edge_data["bevel_weight"] = _get(me.edges, "bevel_weight", ne, np.float32)
+    if len(me.vertex_colors) == 0 and me.has_custom_normals:
+        d.not_carried.append("custom split normals")
+    d.soup = {"positions": positions, "face_sizes": loop_total, "corners": corners, "channels": channels}
+    return d
+
+
+def channel(soup, name, domain):
+    for n, dom, values in soup["channels"]:
+        if n == name and dom == domain:
+            return values
+    return None
+
+
+def same_topology(before, after):
+    """True when the result has the input's vertices and polygons (positions or attributes
+    may differ): it can then be written in place, keeping everything hedge does not carry."""
+    return (len(before["positions"]) == len(after["positions"])
+            and np.array_equal(before["face_sizes"], after["face_sizes"])
+            and np.array_equal(before["corners"], after["corners"]))
+
+
+def _edge_keys(pairs, n):
+    a = np.minimum(pairs[:, 0], pairs[:, 1]).astype(np.int64)
+    b = np.maximum(pairs[:, 0], pairs[:, 1]).astype(np.int64)
+    return a * max(n, 1) + b
+
+
+def _write_channels_in_place(me, data, result):
+    """Topology unchanged: positions and the channels hedge may have changed, nothing else."""
+    _set(me.vertices, "co", result["positions"])
+    inverse = None
+    if data.loop_order is not None:
+        inverse = np.empty_like(data.loop_order)
+        inverse[data.loop_order] = np.arange(len(data.loop_order))
+    _write_attributes(me, data, result, create=False, loop_inverse=inverse)
+
+
+def _write_attributes(me, data, result, create, loop_inverse=None):
+    soup = result
+
+    def loops(values):
+        return values if loop_inverse is None else values[loop_inverse]
+
+    for name in data.uv_names:
+        values = channel(soup, "uv:" + name, "corner")
+        if values is None:
+            continue
+        layer = me.uv_layers.get(name) if not create else me.uv_layers.new(name=name, do_init=False)
+        if layer is not None:
+            _set(layer.data, "uv", loops(values))
+    if create:
+        if data.active_uv and data.active_uv in me.uv_layers:
+            me.uv_layers.active = me.uv_layers[data.active_uv]
+        if data.render_uv and data.render_uv in me.uv_layers:
+            me.uv_layers[data.render_uv].active_render = True
+
+    for prefix, entries in (("color:", data.colors), ("attr:", data.attributes)):
+        for name, data_type, bl_domain in entries:
+            values = channel(soup, prefix + name, DOMAINS[bl_domain])
+            if values is None:
+                continue
+            if create:
+                attr = (me.color_attributes.new(name, data_type, bl_domain) if prefix == "color:"
+                        else me.attributes.new(name, data_type, bl_domain))
+            else:
+                attr = me.attributes.get(name)
+            if attr is None:
+                continue
+            prop, dtype, _ = ATTRIBUTE_TYPES[data_type]
+            if dtype == np.bool_:
+                values = values.view(np.bool_)
+            if bl_domain == 'CORNER':
+                values = loops(values)
+            _set(attr.data, prop, values)
+    if create and data.colors:
+        if data.active_color and data.active_color in me.color_attributes:
+            me.color_attributes.active_color = me.color_attributes[data.active_color]
+        if data.render_color and data.render_color in me.color_attributes:
+            me.color_attributes.render_color_index = me.color_attributes.find(data.render_color)
+
+    for name, domain, collection, prop, dtype in (
+            ("material", "face", me.polygons, "material_index", np.int32),
+            ("smooth", "face", me.polygons, "use_smooth", np.bool_),
+            ("selected", "vertex", me.vertices, "select", np.bool_),
+            ("selected", "face", me.polygons, "select", np.bool_),
+            ("hidden", "vertex", me.vertices, "hide", np.bool_),
+            ("hidden", "face", me.polygons, "hide", np.bool_),
+            ("bevel_weight", "vertex", me.vertices, "bevel_weight", np.float32)):
+        values = channel(soup, name, domain)
+        if values is not None:
+            _set(collection, prop, values.view(dtype) if dtype == np.bool_ else values.astype(dtype, copy=False))
+
+
+def _write_edges(me, data, result):
+    """Edge data follows the source-vertex pair of each new edge (both ends must come from
+    vertices that were joined by an edge carrying the data)."""
+    if not data.edge_data:
+        return
+    source = channel(result, "blender:vertex", "vertex")
+    ne = len(me.edges)
+    if source is None or ne == 0 or len(data.edges) == 0:
+        return
+    n_before = len(data.soup["positions"])
+    old_keys = _edge_keys(data.edges, n_before)
+    order = np.argsort(old_keys, kind="stable")
+    sorted_keys = old_keys[order]
+    new_pairs = _get(me.edges, "vertices", ne, np.int32, 2)
+    src = source[new_pairs]
+    new_keys = _edge_keys(src, n_before)
+    pos = np.searchsorted(sorted_keys, new_keys)
+    pos = np.minimum(pos, len(sorted_keys) - 1)
+    found = (sorted_keys[pos] == new_keys) & (src[:, 0] != src[:, 1])
+    match = order[pos]
+    for name, values in data.edge_data.items():
+        if name.startswith("attr:"):
+            continue
+        out = np.zeros(ne, values.dtype)
+        out[found] = values[match[found]]
+        _set(me.edges, name, out)
+    for name, data_type in data.edge_attributes:
+        values = data.edge_data["attr:" + name]
+        prop, dtype, comps = ATTRIBUTE_TYPES[data_type]
+        attr = me.attributes.new(name, data_type, 'EDGE')
+        out = np.zeros((ne, comps) if comps > 1 else ne, values.dtype)
+        out[found] = values[match[found]]
+        _set(attr.data, prop, out)
+
+
+def write_mesh(me, data, result, rebuild=False):
+    """Writes a result dict into `me`. Same topology: in place (unless `rebuild`). Otherwise
+    the geometry is rebuilt and every layer recreated from its channel."""
+    if not rebuild and same_topology(data.soup, result):
+        _write_channels_in_place(me, data, result)
+        me.update()
+        return
+    positions = result["positions"]
+    sizes = result["face_sizes"]
+    corners = result["corners"]
+    nv, nf, nc = len(positions), len(sizes), len(corners)
+    me.clear_geometry()
+    me.vertices.add(nv)
+    me.loops.add(nc)
+    me.polygons.add(nf)
+    _set(me.vertices, "co", positions)
+    _set(me.loops, "vertex_index", corners)
+    starts = np.zeros(nf, np.int32)
+    if nf:
+        np.cumsum(sizes[:-1], out=starts[1:])
+    _set(me.polygons, "loop_start", starts)
+    _set(me.polygons, "loop_total", sizes)
+    me.update(calc_edges=True)
+    _write_attributes(me, data, result, create=True)
+    _write_edges(me, data, result)
+    me.update()
+
+
+def write_new(me, soup):
+    """Fills an empty mesh from a soup read by hedge's file reader (positions, polygons, and
+    the file's per-corner or per-vertex "uv" as a UV map; other channels are not imported)."""
+    data = MeshData()
+    data.soup = {"positions": np.zeros((0, 3), np.float32), "face_sizes": np.zeros(0, np.int32),
+                 "corners": np.zeros(0, np.int32), "channels": []}
+    channels = []
+    nf = len(soup["face_sizes"])
+    for name, domain, values in soup["channels"]:
+        if name == "uv" and values.dtype == np.float32 and values.ndim == 2 and values.shape[1] == 2:
+            channels.append(("uv:UVMap", "corner", values if domain == "corner" else values[soup["corners"]]))
+            data.uv_names = ["UVMap"]
+            data.active_uv = data.render_uv = "UVMap"
+    result = dict(soup, channels=channels)
+    if nf == 0 and len(soup["positions"]) == 0:
+        return
+    write_mesh(me, data, result)

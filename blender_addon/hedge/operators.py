@@ -1,0 +1,173 @@
+# One operator per catalogue operation, generated from the catalogue: mesh.hedge_<id> with
+# properties named as the parameter ids (defaults, ranges, enums, help as tooltips), REGISTER
+# and UNDO so the redo panel adjusts the last run. Interactive runs work on a thread with
+# the progress bar and Esc to cancel; execute() (redo, scripts) runs synchronously.
+import bpy
+
+from . import api
+from .native import Error, Cancelled, require_native
+
+INT_LIMIT = 2**31 - 1
+FLOAT_LIMIT = 3.0e38
+# Operation ids of the interactive runs in progress (for tests and scripts that wait).
+running = set()
+
+# What the Blender exchange does not carry, said in every tooltip of a changing operation.
+NOT_CARRIED = ("Not carried when the connectivity changes: vertex groups, shape keys, custom split "
+               "normals, loose edges; edge data (seams, sharp, crease) follows edges whose ends "
+               "both come from the vertices of such an edge")
+
+
+def first_paragraph(text):
+    return text.strip().split("\n\n")[0].replace("\n", " ")
+
+
+def make_property(p):
+    help_text = f"{p['help']} [{p['id']}: {p['range_text']}]"
+    if p["type"] == "bool":
+        return bpy.props.BoolProperty(name=p["label"], description=help_text, default=bool(p["default"]))
+    if p["type"] == "int":
+        lo, hi = max(int(p["min"]), -INT_LIMIT), min(int(p["max"]), INT_LIMIT)
+        return bpy.props.IntProperty(name=p["label"], description=help_text, default=int(p["default"]),
+                                     min=lo, max=hi, soft_min=lo, soft_max=hi)
+    if p["type"] == "float":
+        lo, hi = max(p["min"], -FLOAT_LIMIT), min(p["max"], FLOAT_LIMIT)
+        return bpy.props.FloatProperty(name=p["label"], description=help_text, default=p["default"],
+                                       min=lo, max=hi, soft_min=lo, soft_max=hi, precision=4)
+    if p["type"] == "enum":
+        items = [(c, c.replace("_", " ").title(), f"{p['help']} ({c})") for c in p["choices"]]
+        return bpy.props.EnumProperty(name=p["label"], description=help_text, items=items, default=p["default"])
+    raise Error(f"parameter {p['id']}: unknown type {p['type']}")
+
+
+class HedgeOperator:
+    """Shared by the generated operators; `operation` is the catalogue entry."""
+    operation = None
+
+    @classmethod
+    def poll(cls, context):
+        return bool(api.targets(context))
+
+    def params(self):
+        return {p["id"]: getattr(self, p["id"]) for p in self.operation["params"]}
+
+    def done(self, context, reports):
+        op = self.operation
+        for report in reports:
+            self.report({'INFO'}, api.summary(op, report))
+            if not op["changes_mesh"]:
+                for key, value in report.items():
+                    if key != "messages":
+                        self.report({'INFO'}, f"  {key}: {value}")
+            for message in report.get("messages", []):
+                self.report({'WARNING'} if message.startswith("input:") else {'INFO'}, message)
+        if context.area:
+            context.area.tag_redraw()
+        return {'FINISHED'}
+
+    def fail(self, error):
+        self.report({'ERROR'}, f"Hedge {self.operation['title']}: {error}")
+        return {'CANCELLED'}
+
+    def execute(self, context):
+        targets = [api.Target(obj) for obj in api.targets(context)]
+        wm = context.window_manager
+        wm.progress_begin(0, 1000)
+        try:
+            reports = api.run_targets(self.operation["id"], targets, self.params(),
+                                      lambda f, stage: wm.progress_update(int(f * 1000)) or True)
+        except Error as e:
+            return self.fail(e)
+        finally:
+            wm.progress_end()
+        return self.done(context, reports)
+
+    # Interactive: a worker thread per mesh, polled by a timer; Esc cancels; the results are
+    # written only when every mesh is done.
+    def invoke(self, context, event):
+        if bpy.app.background or context.window is None:
+            return self.execute(context)
+        self._targets = [api.Target(obj) for obj in api.targets(context)]
+        self._index = -1
+        self._job = None
+        try:
+            self._next()
+        except Error as e:
+            self._release()
+            return self.fail(e)
+        wm = context.window_manager
+        self._timer = wm.event_timer_add(0.1, window=context.window)
+        wm.progress_begin(0, 1000)
+        wm.modal_handler_add(self)
+        running.add(self.operation["id"])
+        return {'RUNNING_MODAL'}
+
+    def _next(self):
+        self._index += 1
+        if self._index < len(self._targets):
+            t = self._targets[self._index]
+            self._job = require_native().Job(self.operation["id"], t.read(), self.params())
+
+    def _release(self):
+        for t in self._targets:
+            t.release()
+        self._job = None
+
+    def _stop(self, context):
+        running.discard(self.operation["id"])
+        wm = context.window_manager
+        wm.event_timer_remove(self._timer)
+        wm.progress_end()
+        if context.workspace:
+            context.workspace.status_text_set(None)
+
+    def modal(self, context, event):
+        if event.type == 'ESC' and self._job is not None:
+            self._job.cancel()
+        if event.type != 'TIMER':
+            return {'RUNNING_MODAL'}
+        n = len(self._targets)
+        fraction, stage = self._job.progress()
+        context.window_manager.progress_update(int((self._index + fraction) / n * 1000))
+        if context.workspace:
+            context.workspace.status_text_set(f"Hedge {self.operation['title']}: {stage} "
+                                              f"({100 * fraction:.0f} %) - Esc to cancel")
+        if not self._job.done():
+            return {'RUNNING_MODAL'}
+        try:
+            t = self._targets[self._index]
+            t.result, t.report = self._job.result()
+            t.report["object"] = t.obj.name
+            self._next()
+            if self._index < n:
+                return {'RUNNING_MODAL'}
+            for t in self._targets:
+                t.check_writable(self.operation)
+        except Error as e:
+            self._stop(context)
+            self._release()
+            return self.fail(e)
+        self._stop(context)
+        for t in self._targets:
+            t.write()
+            api.remember(self.operation, t.obj, t.report)
+        return self.done(context, [t.report for t in self._targets])
+
+
+def make_operator(op):
+    annotations = {p["id"]: make_property(p) for p in op["params"]}
+    description = first_paragraph(op["help"])
+    if op["changes_mesh"]:
+        description = description.rstrip(".") + ". " + NOT_CARRIED
+    return type(f"MESH_OT_hedge_{op['id']}", (HedgeOperator, bpy.types.Operator), {
+        "bl_idname": f"mesh.hedge_{op['id']}",
+        "bl_label": op["title"],
+        "bl_description": description,
+        "bl_options": {'REGISTER', 'UNDO'},
+        "__annotations__": annotations,
+        "operation": op,
+    })
+
+
+def make_operators():
+    return [make_operator(op) for op in require_native().catalogue()]

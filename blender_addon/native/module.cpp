@@ -1,0 +1,372 @@
+// hedge._native: the catalogue and run_operation() for the Blender add-on, on numpy arrays.
+// Python speaks Soup as a dict of arrays; the mesh work runs without the GIL, either
+// synchronously (redo, scripts) or on a worker thread (Job) that a modal operator polls.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <atomic>
+#include <cstring>
+#include <exception>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+
+#include "hedge/catalogue.h"
+#include "hedge/build.h"
+#include "hedge/error.h"
+#include "hedge/io.h"
+
+namespace py = pybind11;
+using namespace hedge;
+
+namespace {
+
+// ---- catalogue ------------------------------------------------------------------------------
+
+py::dict param_dict(const ParamSpec& p) {
+  py::dict d;
+  d["id"] = p.id;
+  d["label"] = p.label;
+  d["help"] = p.help;
+  d["type"] = param_type_name(p.type);
+  switch (p.type) {
+    case ParamType::boolean: d["default"] = p.default_value != 0; break;
+    case ParamType::integer: d["default"] = static_cast<std::int64_t>(p.default_value); break;
+    case ParamType::real: d["default"] = p.default_value; break;
+    case ParamType::choice: d["default"] = p.choices.at(static_cast<std::size_t>(p.default_value)); break;
+  }
+  d["min"] = p.min;
+  d["max"] = p.max;
+  d["choices"] = p.choices;
+  d["range_text"] = p.range_text();
+  return d;
+}
+
+py::list catalogue_list() {
+  py::list ops;
+  for (const Operation& op : catalogue()) {
+    py::dict d;
+    d["id"] = op.id;
+    d["title"] = op.title;
+    d["category"] = op.category;
+    d["help"] = op.help;
+    d["changes_mesh"] = op.changes_mesh;
+    py::list params;
+    for (const auto& p : op.params) params.append(param_dict(p));
+    d["params"] = params;
+    ops.append(d);
+  }
+  return ops;
+}
+
+// ---- numpy <-> Soup -------------------------------------------------------------------------
+
+ScalarType scalar_of(const py::dtype& dt) {
+  const char kind = dt.kind();
+  const auto size = dt.itemsize();
+  if (kind == 'f' && size == 4) return ScalarType::f32;
+  if (kind == 'f' && size == 8) return ScalarType::f64;
+  if (kind == 'i' || kind == 'b') {
+    if (size == 1) return ScalarType::i8;
+    if (size == 2) return ScalarType::i16;
+    if (size == 4) return ScalarType::i32;
+    if (size == 8) return ScalarType::i64;
+  }
+  if (kind == 'u') {
+    if (size == 1) return ScalarType::u8;
+    if (size == 2) return ScalarType::u16;
+    if (size == 4) return ScalarType::u32;
+    if (size == 8) return ScalarType::u64;
+  }
+  throw Error("unsupported array type '" + std::string(py::str(py::handle(dt))) + "'");
+}
+
+py::dtype dtype_of(ScalarType s) {
+  switch (s) {
+    case ScalarType::f32: return py::dtype::of<float>();
+    case ScalarType::f64: return py::dtype::of<double>();
+    case ScalarType::i8: return py::dtype::of<std::int8_t>();
+    case ScalarType::u8: return py::dtype::of<std::uint8_t>();
+    case ScalarType::i16: return py::dtype::of<std::int16_t>();
+    case ScalarType::u16: return py::dtype::of<std::uint16_t>();
+    case ScalarType::i32: return py::dtype::of<std::int32_t>();
+    case ScalarType::u32: return py::dtype::of<std::uint32_t>();
+    case ScalarType::i64: return py::dtype::of<std::int64_t>();
+    case ScalarType::u64: return py::dtype::of<std::uint64_t>();
+  }
+  return py::dtype::of<float>();
+}
+
+Domain domain_of(const std::string& name) {
+  if (name == "vertex") return Domain::vertex;
+  if (name == "face") return Domain::face;
+  if (name == "corner") return Domain::corner;
+  throw Error("unknown channel domain '" + name + "' (vertex, face or corner)");
+}
+
+// A C-contiguous view of any array-like; the buffer is read in place (one memcpy into the Soup).
+py::array contiguous(const py::handle& obj) {
+  return py::array::ensure(obj, py::array::c_style);
+}
+
+Soup soup_from(const py::dict& mesh) {
+  Soup soup;
+  {
+    py::array p = contiguous(mesh["positions"]);
+    if (!p || p.dtype().kind() != 'f' || p.itemsize() != 4) throw Error("positions must be float32");
+    if (p.size() % 3) throw Error("positions: expected rows of 3");
+    soup.positions.resize(static_cast<std::size_t>(p.size() / 3));
+    static_assert(sizeof(Point) == 3 * sizeof(float));
+    if (p.size()) std::memcpy(soup.positions.data(), p.data(), static_cast<std::size_t>(p.nbytes()));
+  }
+  auto indices = [&](const char* key, std::vector<std::uint32_t>& out) {
+    py::array a = contiguous(mesh[key]);
+    if (!a || (a.dtype().kind() != 'i' && a.dtype().kind() != 'u') || a.itemsize() != 4)
+      throw Error(std::string(key) + " must be int32 or uint32");
+    out.resize(static_cast<std::size_t>(a.size()));
+    if (a.size()) std::memcpy(out.data(), a.data(), static_cast<std::size_t>(a.nbytes()));
+  };
+  indices("face_sizes", soup.face_sizes);
+  indices("corners", soup.corners);
+  if (mesh.contains("channels")) {
+    for (const py::handle& item : mesh["channels"]) {
+      auto t = item.cast<py::tuple>();
+      if (t.size() != 3) throw Error("a channel is (name, domain, array)");
+      Channel c;
+      c.name = t[0].cast<std::string>();
+      c.domain = domain_of(t[1].cast<std::string>());
+      py::array a = contiguous(t[2]);
+      c.scalar = scalar_of(a.dtype());
+      const std::size_t n = soup.domain_size(c.domain);
+      c.components = a.ndim() >= 2 ? static_cast<int>(a.size() / std::max<py::ssize_t>(a.shape(0), 1))
+                                   : (n ? static_cast<int>(static_cast<std::size_t>(a.size()) / n) : 1);
+      if (c.components < 1) c.components = 1;
+      c.data.resize(static_cast<std::size_t>(a.nbytes()));
+      if (a.nbytes()) std::memcpy(c.data.data(), a.data(), c.data.size());
+      soup.channels.push_back(std::move(c));
+    }
+  }
+  soup.check();
+  return soup;
+}
+
+// Hands a vector to numpy without copying: the array owns it through a capsule.
+template <class T>
+py::array adopt(std::vector<T>&& v, py::dtype dt, std::vector<py::ssize_t> shape) {
+  auto* owner = new std::vector<T>(std::move(v));
+  py::capsule free_owner(owner, [](void* p) { delete static_cast<std::vector<T>*>(p); });
+  std::vector<py::ssize_t> strides(shape.size());
+  py::ssize_t stride = dt.itemsize();
+  for (std::size_t i = shape.size(); i-- > 0;) {
+    strides[i] = stride;
+    stride *= shape[i];
+  }
+  return py::array(dt, shape, strides, owner->data(), free_owner);
+}
+
+py::dict soup_to(Soup&& soup) {
+  py::dict d;
+  const auto nv = static_cast<py::ssize_t>(soup.positions.size());
+  d["positions"] = adopt(std::move(soup.positions), py::dtype::of<float>(), {nv, 3});
+  const auto nf = static_cast<py::ssize_t>(soup.face_sizes.size());
+  d["face_sizes"] = adopt(std::move(soup.face_sizes), py::dtype::of<std::int32_t>(), {nf});
+  const auto nc = static_cast<py::ssize_t>(soup.corners.size());
+  d["corners"] = adopt(std::move(soup.corners), py::dtype::of<std::int32_t>(), {nc});
+  py::list channels;
+  for (Channel& c : soup.channels) {
+    const auto n = static_cast<py::ssize_t>(c.count());
+    const py::dtype dt = dtype_of(c.scalar);
+    std::vector<py::ssize_t> shape = {n};
+    if (c.components > 1) shape.push_back(c.components);
+    channels.append(py::make_tuple(c.name, domain_name(c.domain), adopt(std::move(c.data), dt, shape)));
+  }
+  d["channels"] = channels;
+  return d;
+}
+
+py::object value_to_py(const Value& v) {
+  return std::visit([](const auto& x) -> py::object { return py::cast(x); }, v);
+}
+
+py::dict report_to(const OperationReport& r) {
+  py::dict d;
+  for (const auto& [key, value] : r.entries) d[py::str(key)] = value_to_py(value);
+  d["messages"] = r.messages;
+  return d;
+}
+
+std::map<std::string, Value> values_from(const Operation& op, const py::dict& params) {
+  std::map<std::string, Value> given;
+  for (const auto& [k, v] : params) {
+    const std::string id = py::str(k);
+    const ParamSpec* spec = op.find_param(id);
+    if (py::isinstance<py::bool_>(v)) given[id] = v.cast<bool>();
+    else if (py::isinstance<py::int_>(v)) given[id] = v.cast<std::int64_t>();
+    else if (py::isinstance<py::float_>(v)) given[id] = v.cast<double>();
+    else if (py::isinstance<py::str>(v)) given[id] = v.cast<std::string>();
+    else if (spec) throw Error(op.id + ": parameter " + id + " must be " + spec->range_text());
+    else given[id] = std::string(py::str(v));  // resolve_params names the unknown id
+  }
+  return given;
+}
+
+// ---- running --------------------------------------------------------------------------------
+
+struct Prepared {
+  const Operation* op;
+  Soup soup;
+  ParamValues values;
+};
+
+Prepared prepare(const std::string& op_id, const py::dict& mesh, const py::dict& params) {
+  const Operation& op = find_operation(op_id);
+  ParamValues values = resolve_params(op, values_from(op, params));  // refused before any work
+  return {&op, soup_from(mesh), std::move(values)};
+}
+
+py::tuple finish(RunResult&& result, const Operation& op) {
+  py::object soup = op.changes_mesh ? py::object(soup_to(std::move(result.soup))) : py::none();
+  return py::make_tuple(soup, report_to(result.report));
+}
+
+// Synchronous run; `progress` is None or callable(fraction, stage) -> bool (False cancels).
+py::tuple run(const std::string& op_id, const py::dict& mesh, const py::dict& params, const py::object& progress) {
+  Prepared p = prepare(op_id, mesh, params);
+  RunResult result;
+  {
+    Progress::Callback cb;
+    if (!progress.is_none())
+      cb = [&progress](double fraction, const std::string& stage) {
+        py::gil_scoped_acquire gil;
+        py::object r = progress(fraction, stage);
+        return r.is_none() || r.cast<bool>();
+      };
+    Progress prog(cb);
+    py::gil_scoped_release nogil;
+    result = run_operation(*p.op, p.soup, p.values, prog);
+  }
+  return finish(std::move(result), *p.op);
+}
+
+// An operation on a worker thread: the modal operator polls progress(), may cancel(), and
+// collects result() once done() (which rethrows the operation's error).
+class Job {
+ public:
+  Job(const std::string& op_id, const py::dict& mesh, const py::dict& params)
+      : prepared_(prepare(op_id, mesh, params)) {
+    thread_ = std::thread([this] {
+      Progress prog([this](double fraction, const std::string& stage) {
+        {
+          std::lock_guard lock(mutex_);
+          fraction_ = fraction;
+          stage_ = stage;
+        }
+        return !cancel_.load();
+      });
+      try {
+        result_ = run_operation(*prepared_.op, prepared_.soup, prepared_.values, prog);
+      } catch (...) {
+        error_ = std::current_exception();
+      }
+      done_.store(true);
+    });
+  }
+  ~Job() {
+    cancel_.store(true);
+    if (thread_.joinable()) {
+      py::gil_scoped_release nogil;
+      thread_.join();
+    }
+  }
+  bool done() const { return done_.load(); }
+  void cancel() { cancel_.store(true); }
+  py::tuple progress() {
+    std::lock_guard lock(mutex_);
+    return py::make_tuple(fraction_, stage_);
+  }
+  py::tuple result() {
+    {
+      py::gil_scoped_release nogil;
+      if (thread_.joinable()) thread_.join();
+    }
+    if (error_) std::rethrow_exception(error_);
+    if (!result_) throw Error("the result was already taken");
+    RunResult r = std::move(*result_);
+    result_.reset();
+    return finish(std::move(r), *prepared_.op);
+  }
+
+ private:
+  Prepared prepared_;
+  std::thread thread_;
+  std::atomic<bool> done_{false}, cancel_{false};
+  std::mutex mutex_;
+  double fraction_ = 0;
+  std::string stage_;
+  std::optional<RunResult> result_;
+  std::exception_ptr error_;
+};
+
+// build() then extract() with nothing in between: the exchange's no-op round trip.
+py::dict build_extract(const py::dict& mesh) {
+  Soup soup = soup_from(mesh);
+  Soup out;
+  {
+    py::gil_scoped_release nogil;
+    out = extract(build(soup).mesh);
+  }
+  return soup_to(std::move(out));
+}
+
+py::dict read_file(const std::string& path) {
+  Soup soup;
+  {
+    py::gil_scoped_release nogil;
+    soup = read_mesh(path);
+  }
+  return soup_to(std::move(soup));
+}
+
+void write_file(const py::dict& mesh, const std::string& path) {
+  Soup soup = soup_from(mesh);
+  py::gil_scoped_release nogil;
+  write_mesh(soup, path);
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_native, m) {
+  m.doc() = "hedge half-edge mesh processing: the operation catalogue on numpy arrays";
+  static py::exception<Error> error_type(m, "Error", PyExc_RuntimeError);
+  static py::exception<Cancelled> cancelled_type(m, "Cancelled", error_type.ptr());
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const Cancelled& e) {
+      cancelled_type(e.what());
+    } catch (const Error& e) {
+      error_type(e.what());
+    } catch (const std::bad_alloc&) {
+      error_type("out of memory");
+    }
+  });
+  m.def("catalogue", &catalogue_list, "Every operation with its parameters, in menu order.");
+  m.def("run", &run, py::arg("operation"), py::arg("mesh"), py::arg("params") = py::dict(),
+        py::arg("progress") = py::none(),
+        "Runs one operation on a mesh dict (positions, face_sizes, corners, channels); returns "
+        "(mesh dict or None, report dict). Raises Error, or Cancelled when progress returns False.");
+  m.def("build_extract", &build_extract, py::arg("mesh"),
+        "build() and extract() with nothing in between (the no-op round trip).");
+  m.def("read_mesh", &read_file, py::arg("path"), "Reads OFF/OBJ/PLY/STL with hedge's reader into a mesh dict.");
+  m.def("write_mesh", &write_file, py::arg("mesh"), py::arg("path"), "Writes a mesh dict with hedge's writer.");
+  py::class_<Job>(m, "Job")
+      .def(py::init<const std::string&, const py::dict&, const py::dict&>(), py::arg("operation"), py::arg("mesh"),
+           py::arg("params") = py::dict())
+      .def("done", &Job::done)
+      .def("cancel", &Job::cancel)
+      .def("progress", &Job::progress)
+      .def("result", &Job::result);
+}

@@ -1,0 +1,250 @@
+# Every operator on Blender's own primitives (cube, UV sphere, Suzanne) and on real meshes,
+# with the results checked: face counts, holes, edge lengths, UV layers and their continuity,
+# attributes kept; Edit Mode; undo; batch API errors.
+import os
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import bmesh  # noqa: E402
+import bpy  # noqa: E402
+import numpy as np  # noqa: E402
+import unittest  # noqa: E402
+from blender_test import (ARGS, add_primitive, boundary_loops, clear_scene, counts, edge_lengths,  # noqa: E402
+                          import_mesh, install_addon, mesh_arrays, run_tests, select_only)
+
+hedge = install_addon()
+
+
+def uv_seam_edges(me, layer):
+    """Edges with two faces whose UVs differ at either end (UV seams), counted with numpy."""
+    nl = len(me.loops)
+    uv = np.empty(nl * 2, np.float32)
+    me.uv_layers[layer].data.foreach_get("uv", uv)
+    uv = uv.reshape(-1, 2)
+    v = np.empty(nl, np.int32)
+    e = np.empty(nl, np.int32)
+    me.loops.foreach_get("vertex_index", v)
+    me.loops.foreach_get("edge_index", e)
+    total = np.empty(len(me.polygons), np.int32)
+    start = np.empty(len(me.polygons), np.int32)
+    me.polygons.foreach_get("loop_total", total)
+    me.polygons.foreach_get("loop_start", start)
+    face = np.repeat(np.arange(len(total)), total)
+    nxt = np.arange(nl) + 1
+    last = start + total - 1
+    nxt[last] = start
+    # Per loop: its edge, and the UVs at the edge's lower and higher vertex from this face.
+    lo_first = v < v[nxt]
+    uv_lo = np.where(lo_first[:, None], uv, uv[nxt])
+    uv_hi = np.where(lo_first[:, None], uv[nxt], uv)
+    order = np.argsort(e, kind="stable")
+    es, lo, hi = e[order], uv_lo[order], uv_hi[order]
+    pair = es[1:] == es[:-1]
+    differ = pair & (np.any(lo[1:] != lo[:-1], axis=1) | np.any(hi[1:] != hi[:-1], axis=1))
+    del face
+    return int(differ.sum())
+
+
+def add_uv_sphere():
+    obj = add_primitive("uv_sphere", segments=48, ring_count=24)
+    return obj
+
+
+def punch_holes(obj, faces):
+    """Deletes some faces (holes) in Edit Mode, back to Object Mode."""
+    select_only(obj)
+    bpy.ops.object.mode_set(mode='EDIT')
+    bm = bmesh.from_edit_mesh(obj.data)
+    bm.faces.ensure_lookup_table()
+    bmesh.ops.delete(bm, geom=[bm.faces[i] for i in faces], context='FACES_ONLY')
+    bmesh.update_edit_mesh(obj.data)
+    bpy.ops.object.mode_set(mode='OBJECT')
+    return obj
+
+
+def add_attributes(obj):
+    me = obj.data
+    nv, nf, nl = len(me.vertices), len(me.polygons), len(me.loops)
+    a = me.attributes.new("temperature", 'FLOAT', 'POINT')
+    a.data.foreach_set("value", np.linspace(0, 1, nv, dtype=np.float32))
+    b = me.attributes.new("face_id", 'INT', 'FACE')
+    b.data.foreach_set("value", np.arange(nf, dtype=np.int32) % 7)
+    c = me.color_attributes.new("paint", 'BYTE_COLOR', 'CORNER')
+    c.data.foreach_set("color_srgb", np.tile(np.array([1, 0.5, 0.25, 1], np.float32), nl))
+    me.polygons.foreach_set("material_index", (np.arange(nf) % 2).astype(np.int32))
+
+
+class PrimitivesTest(unittest.TestCase):
+    def setUp(self):
+        clear_scene()
+
+    def test_decimate_keeps_uvs_and_attributes(self):
+        obj = add_uv_sphere()
+        add_attributes(obj)
+        bpy.ops.mesh.hedge_triangulate()
+        me = obj.data
+        faces = len(me.polygons)
+        seams = uv_seam_edges(me, "UVMap")
+        bpy.ops.mesh.hedge_decimate(target_ratio=0.2)
+        self.assertAlmostEqual(len(me.polygons), faces * 0.2, delta=faces * 0.02)
+        self.assertIn("UVMap", me.uv_layers)
+        self.assertLessEqual(uv_seam_edges(me, "UVMap"), seams, "decimate made new UV seams")
+        self.assertIn("temperature", me.attributes)
+        self.assertEqual(me.attributes["temperature"].domain, 'POINT')
+        self.assertEqual(me.attributes["face_id"].data_type, 'INT')
+        self.assertIn("paint", me.color_attributes)
+        arr = mesh_arrays(me)
+        self.assertTrue(np.all(np.abs(arr["attr:paint:CORNER"].reshape(-1, 4) - [1, 0.5, 0.25, 1]) < 1e-6))
+        self.assertTrue(set(np.unique(arr["material"])) <= {0, 1})
+        t = arr["attr:temperature:POINT"]
+        self.assertTrue(np.all((t >= 0) & (t <= 1)))
+        self.assertEqual(boundary_loops(me), 0)
+
+    def test_subdivide_cube_and_suzanne(self):
+        cube = add_primitive("cube")
+        bpy.ops.mesh.hedge_subdivide(scheme='catmull_clark', iterations=2)
+        self.assertEqual(len(cube.data.polygons), 6 * 16)
+        self.assertTrue(np.all(mesh_arrays(cube.data)["loop_total"] == 4))
+        self.assertIn("UVMap", cube.data.uv_layers)
+        monkey = add_primitive("monkey")
+        bpy.ops.mesh.hedge_triangulate(method='ear_clipping')
+        n = len(monkey.data.polygons)
+        self.assertTrue(np.all(mesh_arrays(monkey.data)["loop_total"] == 3))
+        bpy.ops.mesh.hedge_subdivide(scheme='loop', iterations=1)
+        self.assertEqual(len(monkey.data.polygons), 4 * n)
+
+    def test_triangulate_polygons(self):
+        obj = add_primitive("cylinder", vertices=32)  # two 32-gons and quads
+        bpy.ops.mesh.hedge_triangulate(method='min_area')
+        arr = mesh_arrays(obj.data)
+        self.assertTrue(np.all(arr["loop_total"] == 3))
+        self.assertEqual(len(obj.data.polygons), 2 * 30 + 2 * 32)
+
+    def test_fill_holes(self):
+        obj = punch_holes(add_uv_sphere(), [100, 101, 500, 700, 701, 702])
+        self.assertEqual(boundary_loops(obj.data), 3)
+        report = hedge.run(obj, "fill_holes")
+        self.assertEqual(boundary_loops(obj.data), 0, report)
+
+    def test_remesh_edge_lengths(self):
+        obj = add_uv_sphere()
+        bpy.ops.mesh.hedge_remesh(target_edge_length=0.1, iterations=5)
+        lengths = edge_lengths(obj.data)
+        self.assertTrue(np.all(mesh_arrays(obj.data)["loop_total"] == 3))
+        self.assertAlmostEqual(float(np.mean(lengths)), 0.1, delta=0.02)
+        self.assertLess(float(np.std(lengths) / np.mean(lengths)), 0.3)
+
+    def test_smooth_in_place_keeps_everything(self):
+        obj = add_primitive("monkey")
+        vg = obj.vertex_groups.new(name="left")
+        vg.add(list(range(0, 200)), 0.75, 'REPLACE')
+        obj.data.edges.foreach_set("use_seam", np.arange(len(obj.data.edges)) % 5 == 0)
+        before = mesh_arrays(obj.data)
+        bpy.ops.mesh.hedge_smooth(method='taubin', iterations=5)
+        after = mesh_arrays(obj.data)
+        self.assertFalse(np.array_equal(before["co"], after["co"]))
+        for key in ("loop_vertex", "loop_total", "edges", "seam", "material", "uv:UVMap"):
+            self.assertTrue(np.array_equal(before[key], after[key]), key)
+        self.assertEqual(obj.vertex_groups["left"].weight(150), 0.75)
+
+    def test_make_delaunay_and_repair(self):
+        obj = add_uv_sphere()
+        bpy.ops.mesh.hedge_triangulate()
+        n = len(obj.data.polygons)
+        bpy.ops.mesh.hedge_make_delaunay()
+        self.assertEqual(len(obj.data.polygons), n)
+        bpy.ops.mesh.hedge_repair(weld_distance=1e-5)
+        self.assertEqual(len(obj.data.polygons), n)
+
+    def test_report(self):
+        obj = add_primitive("monkey")
+        bpy.ops.mesh.hedge_report()
+        report = hedge.api.last_reports["report:" + obj.name]
+        self.assertEqual(report["faces"], 500)
+        report2 = hedge.run(obj, "report")
+        self.assertEqual(report2["faces"], 500)
+
+    def test_several_objects_and_shared_mesh(self):
+        a = add_primitive("uv_sphere")
+        b = add_primitive("monkey", location=(3, 0, 0))
+        c = bpy.data.objects.new("linked", b.data)
+        bpy.context.collection.objects.link(c)
+        for o in (a, b, c):
+            o.select_set(True)
+        fa, fb = len(a.data.polygons), len(b.data.polygons)
+        bpy.ops.mesh.hedge_subdivide(scheme='midpoint')
+        self.assertEqual(len(a.data.polygons), 4 * fa)
+        self.assertGreater(len(b.data.polygons), 3 * fb)  # once, though two objects use it
+
+    def test_edit_mode(self):
+        obj = add_primitive("monkey")
+        bpy.ops.object.mode_set(mode='EDIT')
+        bpy.ops.mesh.hedge_triangulate()
+        bpy.ops.mesh.hedge_decimate(target_faces=300)
+        bm = bmesh.from_edit_mesh(obj.data)
+        self.assertEqual(len(bm.faces), 300)
+        bpy.ops.object.mode_set(mode='OBJECT')
+        self.assertEqual(len(obj.data.polygons), 300)
+
+    def test_undo_restores(self):
+        obj = add_primitive("monkey")
+        bpy.ops.ed.undo_push(message="before")
+        before = mesh_arrays(obj.data)
+        bpy.ops.mesh.hedge_decimate(target_ratio=0.3)
+        self.assertLess(len(obj.data.polygons), 500)
+        bpy.ops.ed.undo()
+        obj = bpy.data.objects[obj.name]
+        after = mesh_arrays(obj.data)
+        for key in before:
+            self.assertTrue(np.array_equal(before[key], after[key]), key)
+
+    def test_out_of_range_refused(self):
+        add_primitive("cube")
+        with self.assertRaises((TypeError, ValueError)):
+            bpy.ops.mesh.hedge_decimate(target_ratio="much")
+        # Blender clamps to the property's hard limits: the operator never sees 5.
+        op = bpy.ops.mesh.hedge_decimate.get_rna_type().properties["target_ratio"]
+        self.assertEqual(op.hard_max, 1.0)
+        with self.assertRaises(hedge.Error):
+            hedge.run(bpy.context.active_object, "decimate", target_ratio=5.0)
+        with self.assertRaises(hedge.Error):
+            hedge.run(bpy.context.active_object, "decimate", no_such_parameter=1)
+        with self.assertRaises(hedge.Error):
+            hedge.run(bpy.context.active_object, "no_such_operation")
+
+
+class RealMeshesTest(unittest.TestCase):
+    def setUp(self):
+        clear_scene()
+        if not ARGS.meshes or not os.path.isdir(ARGS.meshes):
+            self.skipTest("no meshes folder")
+
+    def path(self, name):
+        p = os.path.join(ARGS.meshes, name)
+        if not os.path.exists(p):
+            self.skipTest(f"{p} missing")
+        return p
+
+    def test_dragon_res2_every_operator(self):
+        for op in hedge.catalogue():
+            clear_scene()
+            obj = import_mesh(self.path("dragon_res2.ply"))
+            faces = len(obj.data.polygons)
+            params = {"subdivide": {"scheme": 'midpoint'}, "remesh": {"iterations": 2}}.get(op["id"], {})
+            result = getattr(bpy.ops.mesh, f"hedge_{op['id']}")(**params)
+            self.assertEqual(result, {'FINISHED'}, op["id"])
+            if op["id"] == "decimate":
+                self.assertAlmostEqual(len(obj.data.polygons), faces // 2, delta=faces * 0.01)
+
+    def test_bunny_through_hedge_reader(self):
+        obj = hedge.api.import_file(self.path("bunny.off"))
+        select_only(obj)
+        holes = boundary_loops(obj.data)
+        report = hedge.run(obj, "report")
+        self.assertEqual(report["faces"], len(obj.data.polygons))
+        self.assertGreater(holes, 0)
+        hedge.run(obj, "fill_holes")
+        self.assertLess(boundary_loops(obj.data), holes)
+
+
+run_tests(PrimitivesTest, RealMeshesTest)
