@@ -8,6 +8,8 @@
 // - outer halves of boundary edges form loops too (holes); every vertex is manifold (one
 //   fan), and a boundary vertex's halfedge(v) is its outgoing boundary half-edge.
 // - deleted elements stay in the arrays until garbage_collect().
+// - two edges may join the same two vertices (build() keeps such pinches of the input;
+//   repair removes them); validate() accepts them, Euler operations never make new ones.
 #pragma once
 
 #include <cstddef>
