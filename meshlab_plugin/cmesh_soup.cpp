@@ -13,6 +13,7 @@
 #include <set>
 #include <string>
 #include <typeindex>
+#include <unordered_map>
 #include <vector>
 
 namespace hedge::meshlab {
@@ -112,6 +113,108 @@ std::vector<vcg::Color4b> colors_of(const Soup& soup, Domain domain) {
   return colors;
 }
 
+struct CornerWedge {
+  std::size_t face;
+  std::uint8_t wedge;
+};
+
+// MeshLab stores a polygon as triangles joined by faux edges. Joins every two triangles that
+// share a faux edge and walks each group's real edges into one polygon, starting at its first
+// triangle's first real edge (where a fan written by write_soup_to_mesh starts, so polygons
+// survive a chain of Hedge filters). A group whose real edges are not one simple loop stays
+// separate triangles. Polygons come in the order of their first triangle.
+void gather_polygons(const CMeshO& m, const std::vector<std::size_t>& triangles,
+                     const std::vector<std::uint32_t>& triangle_vertices, Soup& soup,
+                     std::vector<std::size_t>& live_faces, std::vector<CornerWedge>& corner_wedges) {
+  const std::size_t n = triangles.size();
+  std::vector<std::uint32_t> parent(n);
+  for (std::size_t t = 0; t < n; ++t) parent[t] = static_cast<std::uint32_t>(t);
+  auto root = [&](std::uint32_t t) {
+    while (parent[t] != t) t = parent[t] = parent[parent[t]];
+    return t;
+  };
+  std::vector<std::uint8_t> joined(3 * n, 0);  // this faux edge joins two triangles
+  std::unordered_map<std::uint64_t, std::uint32_t> waiting;  // faux edge -> the first triangle side met
+  constexpr std::uint32_t kTaken = kNoIndex;
+  for (std::size_t t = 0; t < n; ++t)
+    for (int j = 0; j < 3; ++j) {
+      if (!m.face[triangles[t]].IsF(j)) continue;
+      const std::uint32_t a = triangle_vertices[3 * t + j], b = triangle_vertices[3 * t + (j + 1) % 3];
+      const std::uint64_t key = (std::uint64_t(std::min(a, b)) << 32) | std::max(a, b);
+      const auto side = static_cast<std::uint32_t>(3 * t + j);
+      auto [it, first] = waiting.try_emplace(key, side);
+      if (first || it->second == kTaken) continue;  // a third faux side on one edge joins nothing
+      joined[it->second] = joined[side] = 1;
+      parent[root(it->second / 3)] = root(static_cast<std::uint32_t>(t));
+      it->second = kTaken;
+    }
+
+  // Members of each group in triangle order (counting sort by root).
+  std::vector<std::uint32_t> group_start(n + 1, 0), members(n);
+  for (std::size_t t = 0; t < n; ++t) ++group_start[root(static_cast<std::uint32_t>(t)) + 1];
+  for (std::size_t r = 0; r < n; ++r) group_start[r + 1] += group_start[r];
+  std::vector<std::uint32_t> fill(group_start.begin(), group_start.end() - 1);
+  for (std::size_t t = 0; t < n; ++t) members[fill[root(static_cast<std::uint32_t>(t))]++] = static_cast<std::uint32_t>(t);
+
+  auto emit_triangle = [&](std::uint32_t t) {
+    live_faces.push_back(triangles[t]);
+    soup.face_sizes.push_back(3);
+    for (std::uint8_t j = 0; j < 3; ++j) {
+      soup.corners.push_back(triangle_vertices[3 * t + j]);
+      corner_wedges.push_back({triangles[t], j});
+    }
+  };
+  struct Side {
+    std::uint32_t from, to, triangle;
+    std::uint8_t wedge;
+  };
+  std::vector<Side> sides;
+  std::vector<std::uint8_t> walked;
+  for (std::size_t t = 0; t < n; ++t) {
+    const std::uint32_t r = root(static_cast<std::uint32_t>(t));
+    const std::uint32_t* first = members.data() + group_start[r];
+    const std::uint32_t* last = members.data() + group_start[r + 1];
+    if (*first != t) continue;  // emitted with its group's first triangle
+    if (last - first == 1) {
+      emit_triangle(static_cast<std::uint32_t>(t));
+      continue;
+    }
+    sides.clear();
+    for (const std::uint32_t* g = first; g != last; ++g)
+      for (std::uint8_t j = 0; j < 3; ++j)
+        if (!joined[3 * *g + j])
+          sides.push_back({triangle_vertices[3 * *g + j], triangle_vertices[3 * *g + (j + 1) % 3], *g, j});
+    // Walk from the first real side; every step must find exactly one unwalked side.
+    walked.assign(sides.size(), 0);
+    std::vector<std::size_t> loop;
+    std::size_t at = 0;
+    bool simple = !sides.empty();
+    while (simple && !walked[at]) {
+      walked[at] = 1;
+      loop.push_back(at);
+      std::size_t next = sides.size();
+      for (std::size_t k = 0; k < sides.size(); ++k)
+        if (sides[k].from == sides[at].to) {
+          if (next != sides.size()) simple = false;  // the boundary touches itself
+          next = k;
+        }
+      if (next == sides.size()) simple = false;
+      at = next;
+    }
+    simple = simple && at == 0 && loop.size() == sides.size();
+    if (!simple) {
+      for (const std::uint32_t* g = first; g != last; ++g) emit_triangle(*g);
+      continue;
+    }
+    live_faces.push_back(triangles[t]);
+    soup.face_sizes.push_back(static_cast<std::uint32_t>(loop.size()));
+    for (std::size_t k : loop) {
+      soup.corners.push_back(sides[k].from);
+      corner_wedges.push_back({triangles[sides[k].triangle], sides[k].wedge});
+    }
+  }
+}
+
 bool same_geometry(const Soup& a, const Soup& b) {
   return a.positions.size() == b.positions.size() && a.face_sizes == b.face_sizes && a.corners == b.corners &&
          std::memcmp(a.positions.data(), b.positions.data(), a.positions.size() * sizeof(Point)) == 0;
@@ -143,18 +246,33 @@ Soup soup_from_mesh(const MeshModel& model) {
     if (v == nullptr || v < &m.vert.front() || v > &m.vert.back()) return kNoIndex;
     return vertex_index[static_cast<std::size_t>(v - &m.vert.front())];
   };
-  std::vector<std::size_t> live_faces;
-  live_faces.reserve(static_cast<std::size_t>(std::max(m.fn, 0)));
-  soup.corners.reserve(3 * static_cast<std::size_t>(std::max(m.fn, 0)));
+  std::vector<std::size_t> triangles;
+  std::vector<std::uint32_t> triangle_vertices;  // 3 soup vertices per triangle
+  triangles.reserve(static_cast<std::size_t>(std::max(m.fn, 0)));
+  triangle_vertices.reserve(3 * static_cast<std::size_t>(std::max(m.fn, 0)));
   for (std::size_t i = 0; i < m.face.size(); ++i) {
     const CFaceO& f = m.face[i];
     if (f.IsD()) continue;
     const std::uint32_t a = vertex_of(f, 0), b = vertex_of(f, 1), c = vertex_of(f, 2);
     if (a == kNoIndex || b == kNoIndex || c == kNoIndex) continue;
-    live_faces.push_back(i);
-    soup.corners.insert(soup.corners.end(), {a, b, c});
+    triangles.push_back(i);
+    triangle_vertices.insert(triangle_vertices.end(), {a, b, c});
   }
-  soup.face_sizes.assign(live_faces.size(), 3);
+  // Soup faces: the triangles, or for a polygonal mesh the polygons their faux edges make.
+  // live_faces[f] is the MeshLab face soup face f takes its attributes from (a polygon's first
+  // triangle); corner_wedges[c] the face and wedge soup corner c takes its own from.
+  std::vector<std::size_t> live_faces;
+  std::vector<CornerWedge> corner_wedges;
+  if (model.hasDataMask(MeshModel::MM_POLYGONAL)) {
+    gather_polygons(m, triangles, triangle_vertices, soup, live_faces, corner_wedges);
+  } else {
+    live_faces = triangles;
+    soup.corners = triangle_vertices;
+    soup.face_sizes.assign(triangles.size(), 3);
+    corner_wedges.resize(soup.corners.size());
+    for (std::size_t t = 0; t < triangles.size(); ++t)
+      for (std::uint8_t j = 0; j < 3; ++j) corner_wedges[3 * t + j] = {triangles[t], j};
+  }
 
   const std::size_t nv = live_vertices.size(), nf = live_faces.size();
   if (model.hasDataMask(MeshModel::MM_VERTNORMAL)) {
@@ -198,15 +316,12 @@ Soup soup_from_mesh(const MeshModel& model) {
   }
   if (model.hasDataMask(MeshModel::MM_WEDGTEXCOORD) && m.face.IsWedgeTexCoordEnabled()) {
     auto* uv = soup.add_channel("uv", Domain::corner, ScalarType::f32, 2).as<float>();
-    bool textured = false;
-    for (std::size_t i = 0; i < nf; ++i) {
-      const CFaceO& f = m.face[live_faces[i]];
-      for (int j = 0; j < 3; ++j) {
-        uv[6 * i + 2 * j] = f.cWT(j).U();
-        uv[6 * i + 2 * j + 1] = f.cWT(j).V();
-      }
-      textured = textured || f.cWT(0).N() != 0;
+    for (std::size_t c = 0; c < corner_wedges.size(); ++c) {
+      const auto& wedge = m.face[corner_wedges[c].face].cWT(corner_wedges[c].wedge);
+      uv[2 * c] = wedge.U();
+      uv[2 * c + 1] = wedge.V();
     }
+    const bool textured = std::any_of(live_faces.begin(), live_faces.end(), [&](std::size_t i) { return m.face[i].cWT(0).N() != 0; });
     // MeshLab keeps the texture index per wedge; hedge keeps one per face, the first wedge's.
     if (textured) {
       auto* material = soup.add_channel("material", Domain::face, ScalarType::i32, 1).as<std::int32_t>();

@@ -15,6 +15,7 @@ namespace hedge::meshlab {
 //! per-wedge texture coordinates (corner "uv") with their texture index (face "material");
 //! face colour, quality and selection; named per-vertex and per-face custom attributes
 //! (passed through as raw channels). Selection channels exist only when something is selected.
+//! A polygonal mesh (MM_POLYGONAL: triangles joined by faux edges) gives its polygons.
 Soup soup_from_mesh(const MeshModel& model);
 
 struct MeshWriteReport {

@@ -124,3 +124,30 @@ def ply_count(path, element):
         if len(words) == 3 and words[0] == "element" and words[1] == element:
             return int(words[2])
     return None
+
+
+def write_quad_cube(path, n):
+    """A closed cube of 6 n^2 quads as an OFF file: MeshLab reads it as a polygonal mesh
+    (triangle pairs joined by faux edges). Not OBJ: MeshLab 2020.09's OBJ reader aborts on quads."""
+    index, vertices, faces = {}, [], []
+
+    def vertex(p):
+        if p not in index:
+            index[p] = len(vertices)
+            vertices.append(p)
+        return index[p]
+
+    for axis in range(3):
+        for side in (0, n):
+            for i in range(n):
+                for j in range(n):
+                    corners = []
+                    for di, dj in ((0, 0), (1, 0), (1, 1), (0, 1)):
+                        p = [0.0, 0.0, 0.0]
+                        p[axis] = float(side)
+                        p[(axis + 1) % 3] = float(i + di)
+                        p[(axis + 2) % 3] = float(j + dj)
+                        corners.append(vertex(tuple(p)))
+                    faces.append(tuple(corners if side else corners[::-1]))
+    write_off(path, vertices, faces)
+    return len(faces)

@@ -287,6 +287,17 @@ TEST_F(PluginTest, PolygonsComeBackAsFauxEdgeFans) {
   for (const CFaceO& f : m.face) EXPECT_EQ(int(f.IsF(0)) + int(f.IsF(1)) + int(f.IsF(2)), 1) << "one diagonal per quad half";
 }
 
+TEST_F(PluginTest, PolygonsSurviveAChainOfFilters) {
+  Document doc(mesh_path("bunny.off"));
+  RichParameterList parameters = doc.defaults(action_of("subdivide"));
+  parameters.setValue("scheme", EnumValue(1));  // catmull_clark: 3 quads per triangle, then 4 per quad
+  ASSERT_TRUE(doc.apply("subdivide", parameters)) << doc.log_text();
+  ASSERT_TRUE(doc.apply("subdivide", parameters)) << doc.log_text();
+  EXPECT_EQ(doc.model->cm.fn, 2 * 4 * 3 * 3674) << "the second step saw quads, not triangle pairs";
+  ASSERT_TRUE(doc.apply("report"));
+  EXPECT_NE(doc.log_text().find("Hedge: Mesh Report: quads = " + std::to_string(4 * 3 * 3674)), std::string::npos);
+}
+
 TEST_F(PluginTest, NoMeshIsAnErrorNotACrash) {
   MeshDocument empty;
   GLLogStream log;

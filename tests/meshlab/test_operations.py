@@ -117,6 +117,28 @@ def test_make_delaunay(ml, checks, bunny):
                      f"{after['mean_min_angle_degrees']:.2f}")
 
 
+def test_polygons(ml, checks):
+    """MeshLab holds a quad mesh as triangles joined by faux edges; Hedge filters see the quads
+    and give polygons back the same way, so Catmull-Clark twice in a row stays all quads."""
+    cube = ml.path("quad_cube.off")
+    quads = mesh_files.write_quad_cube(cube, 4)
+    _, output = run(ml, checks, "polygons_report", cube, [mt.hedge_filter(ml, "report")])
+    checks.check(mt.logged(output, "Hedge: Mesh Report").get("quads") == str(quads),
+                 f"polygons: Hedge sees MeshLab's {quads} faux-edge quads as quads")
+    twice = [mt.hedge_filter(ml, "subdivide", scheme="catmull_clark"), mt.hedge_filter(ml, "subdivide", scheme="catmull_clark"),
+             mt.hedge_filter(ml, "report")]
+    out, output = run(ml, checks, "polygons_catmull_clark_twice", cube, twice)
+    if out:
+        checks.check(mt.logged(output, "Hedge: Mesh Report").get("quads") == str(16 * quads),
+                     f"polygons: Catmull-Clark twice makes {16 * quads} quads")
+        checks.check(mesh_files.ply_count(out, "face") == 32 * quads, f"polygons: saved as {32 * quads} triangles")
+    if "triangulate" in ml.operations:
+        out, output = run(ml, checks, "polygons_triangulate", cube, [mt.hedge_filter(ml, "triangulate"), mt.hedge_filter(ml, "report")])
+        if out:
+            checks.check(mt.logged(output, "Hedge: Mesh Report").get("triangles") == str(2 * quads),
+                         f"polygons: Triangulate turns the {quads} quads into {2 * quads} triangles")
+
+
 def test_any(ml, checks, op, bunny):
     """An operation this test has no specific check for yet: it runs with its defaults and
     gives a mesh back."""
@@ -150,8 +172,8 @@ def test_chain(ml, checks, bunny):
     info = ml.info(out)
     checks.check(info["boundary_loops"] == 0, "chain: no hole in the saved mesh")
     added = int(fill.get("triangles_added", "0"))
-    checks.check(info["faces"] == 5000 + added or info["faces"] == 5001 + added,
-                 f"chain: Quadric Edge Collapse's 5000 faces plus {added} filled = {info['faces']}")
+    checks.check(abs(info["faces"] - added - 5000) <= 2,  # MeshLab's collapses stop within a face or two of the target
+                 f"chain: Quadric Edge Collapse's ~5000 faces plus {added} filled = {info['faces']}")
     checks.check(info["components"] == 1, "chain: one component")
     # The smoothing ran on the flipped mesh; Hedge gives the orientation it was handed back.
     checks.check(ml.report(out)["volume"] < 0, "chain: MeshLab's Invert Faces survived the Hedge filter after it")
@@ -180,6 +202,9 @@ def main():
                 specific.get(op["id"], lambda: test_any(ml, checks, op, bunny))()
             except mt.Failure as e:
                 checks.check(False, f"{op['id']}: {e}")
+        print("== polygons")
+        if "subdivide" in ml.operations:
+            test_polygons(ml, checks)
         print("== chain")
         if all(op in ml.operations for op in ("remesh", "fill_holes", "smooth")):
             test_chain(ml, checks, bunny)
