@@ -1,0 +1,105 @@
+// Shared checks of the fuzz targets: build a soup, validate, and compare extract() with
+// what the soup should come back as (skipped faces removed, channels grouped by domain).
+#pragma once
+#include <algorithm>
+#include <cstring>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include "hedge/build.h"
+#include "hedge/error.h"
+#include "hedge/soup.h"
+#include "hedge/validate.h"
+
+namespace hedge_fuzz {
+
+[[noreturn]] inline void fail(const std::string& what) {
+  std::fprintf(stderr, "FUZZ INVARIANT BROKEN: %s\n", what.c_str());
+  std::fflush(stderr);
+  std::abort();
+}
+
+//! The soup extract(build(soup)) must give back: faces build() skipped removed (with their
+//! face and corner channel entries), channels stably grouped vertex, face, corner.
+inline hedge::Soup expected_round_trip(const hedge::Soup& soup, const std::vector<std::uint32_t>& skipped) {
+  hedge::Soup out;
+  out.positions = soup.positions;
+  std::vector<bool> skip(soup.n_faces(), false);
+  for (auto f : skipped) skip.at(f) = true;
+  auto offsets = soup.face_offsets();
+  std::vector<bool> keep_corner(soup.n_corners(), true);
+  for (std::size_t f = 0; f < soup.n_faces(); ++f) {
+    if (skip[f]) {
+      for (std::size_t c = offsets[f]; c < offsets[f + 1]; ++c) keep_corner[c] = false;
+      continue;
+    }
+    out.face_sizes.push_back(soup.face_sizes[f]);
+    for (std::size_t c = offsets[f]; c < offsets[f + 1]; ++c) out.corners.push_back(soup.corners[c]);
+  }
+  for (hedge::Domain d : {hedge::Domain::vertex, hedge::Domain::face, hedge::Domain::corner}) {
+    for (const auto& ch : soup.channels) {
+      if (ch.domain != d) continue;
+      hedge::Channel c = ch;
+      if (d != hedge::Domain::vertex) {
+        c.data.clear();
+        std::size_t stride = ch.stride();
+        std::size_t n = ch.count();
+        for (std::size_t i = 0; i < n; ++i) {
+          bool keep = d == hedge::Domain::face ? !skip[i] : keep_corner[i];
+          if (keep) c.data.insert(c.data.end(), ch.data.begin() + i * stride, ch.data.begin() + (i + 1) * stride);
+        }
+      }
+      out.channels.push_back(std::move(c));
+    }
+  }
+  return out;
+}
+
+inline std::string describe_difference(const hedge::Soup& a, const hedge::Soup& b) {
+  if (a.positions.size() != b.positions.size())
+    return "vertex count " + std::to_string(a.positions.size()) + " vs " + std::to_string(b.positions.size());
+  for (std::size_t i = 0; i < a.positions.size(); ++i)
+    if (std::memcmp(&a.positions[i], &b.positions[i], sizeof(a.positions[i])) != 0)
+      return "position of vertex " + std::to_string(i);
+  if (a.face_sizes != b.face_sizes) return "face sizes (" + std::to_string(a.face_sizes.size()) + " vs " +
+                                           std::to_string(b.face_sizes.size()) + " faces)";
+  if (a.corners != b.corners) return "corner indices";
+  if (a.channels.size() != b.channels.size())
+    return "channel count " + std::to_string(a.channels.size()) + " vs " + std::to_string(b.channels.size());
+  for (std::size_t i = 0; i < a.channels.size(); ++i)
+    if (!(a.channels[i] == b.channels[i])) return "channel " + std::to_string(i) + " '" + a.channels[i].name + "'";
+  return "";
+}
+
+//! Bitwise soup equality (operator== on float positions treats NaN as unequal and -0 == 0).
+inline bool same_bits(const hedge::Soup& a, const hedge::Soup& b) { return describe_difference(a, b).empty(); }
+
+//! build() -> validate() -> extract() round trip. hedge::Error from build() is an answer,
+//! not a bug; everything else aborts with a message.
+inline void check_build_round_trip(const hedge::Soup& soup) {
+  hedge::BuildResult built;
+  try {
+    built = hedge::build(soup);
+  } catch (const hedge::Error&) {
+    return;
+  }
+  hedge::Validation v = hedge::validate(built.mesh);
+  if (!v) fail("validate after build: " + v.message);
+  if (built.report.skipped_faces != built.maps.skipped_faces.size()) fail("skipped_faces count and map disagree");
+  if (built.mesh.n_faces() != soup.n_faces() - built.maps.skipped_faces.size())
+    fail("face count " + std::to_string(built.mesh.n_faces()) + " != soup faces " + std::to_string(soup.n_faces()) +
+         " - skipped " + std::to_string(built.maps.skipped_faces.size()));
+  hedge::Soup back;
+  try {
+    back = hedge::extract(built.mesh);
+  } catch (const hedge::Error& e) {
+    fail(std::string("extract threw: ") + e.what());
+  }
+  hedge::Soup expected = expected_round_trip(soup, built.maps.skipped_faces);
+  std::string diff = describe_difference(back, expected);
+  if (!diff.empty()) fail("extract(build(soup)) differs from the soup: " + diff);
+}
+
+}  // namespace hedge_fuzz

@@ -1,0 +1,20 @@
+// libFuzzer target: read_stl() on arbitrary bytes; whatever it accepts must build, validate
+// and round-trip through extract().
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+#include "fuzz_common.h"
+#include "hedge/io.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  std::string bytes(reinterpret_cast<const char*>(data), size);
+  hedge::Soup soup;
+  try {
+    soup = hedge::read_stl(bytes, "fuzz");
+  } catch (const hedge::Error&) {
+    return 0;
+  }
+  hedge_fuzz::check_build_round_trip(soup);
+  return 0;
+}
