@@ -91,46 +91,52 @@ struct PackedQuadric {
 // The queue of edges by cost: a radix heap (Ahuja, Mehlhorn, Orlin & Tarjan 1990) over the
 // bit patterns of the float costs (non-negative floats order like their bits). It needs
 // keys that never drop below the last one taken, which quadrics nearly guarantee: merging
-// only adds planes, so an edge's cost only grows; a key below (a fresh re-evaluation of a
-// refused edge) is taken next, as a binary heap would. Pushing appends to a bucket and
-// taking redistributes one bucket, both sequential sweeps: no sift through a tree of
-// random cache lines, which dominated a binary heap's cost here. At most one entry per
-// edge: an entry whose edge changed since is marked stale and re-evaluated when it surfaces
-// (lazy updates); stale costs are lower bounds, so nothing is taken too late.
+// only adds planes, so costs grow; a key below (an edge refused earlier, legal again) is
+// taken next, as a binary heap would take it. Pushing appends to a bucket and taking
+// redistributes one bucket, both sequential sweeps, instead of sifting through a tree of
+// random cache lines, which dominated a binary heap's cost here.
+//
+// Entries are never updated in place: a changed edge gets a new entry, and the old one is
+// recognised as stale by its version stamp when it surfaces (the lowest 8 bits of the key,
+// which costs 2^-15 of relative precision in the ordering).
 class EdgeQueue {
  public:
-  static std::uint32_t key(float cost) {
+  static std::uint32_t key(float cost, std::uint8_t version) {
     std::uint32_t bits;
     std::memcpy(&bits, &cost, sizeof bits);
-    return bits;
+    return (bits & ~0xffu) | version;
   }
+  static std::uint8_t version(std::uint32_t key) { return std::uint8_t(key & 0xffu); }
+  struct Entry {
+    std::uint32_t key;
+    Index edge;
+  };
+
   bool empty() const { return size_ == 0; }
   void clear() {
     for (auto& b : buckets_) b.clear();
     size_ = 0;
     last_ = 0;
   }
-  void push(float cost, Index edge) {
-    std::uint32_t k = key(cost);
-    if (k < last_) k = last_;
+  void push(std::uint32_t k, Index edge) {
+    if (k < last_) {
+      // Below the last key taken: it goes next, keeping its version.
+      k = (last_ & ~0xffu) | (k & 0xffu);
+      if (k < last_) k += 0x100;
+    }
     buckets_[bucket(k)].push_back({k, edge});
     ++size_;
   }
-  //! The edge of least cost; precondition: !empty().
-  Index top() {
+  //! Takes the entry of least key; precondition: !empty().
+  Entry pop() {
     if (buckets_[0].empty()) refill();
-    return buckets_[0].back().edge;
-  }
-  void pop() {
+    const Entry e = buckets_[0].back();
     buckets_[0].pop_back();
     --size_;
+    return e;
   }
 
  private:
-  struct Entry {
-    std::uint32_t key;
-    Index edge;
-  };
   int bucket(std::uint32_t k) const { return k == last_ ? 0 : 32 - std::countl_zero(k ^ last_); }
   void refill() {
     int i = 1;
@@ -147,7 +153,6 @@ class EdgeQueue {
   std::size_t size_ = 0;
 };
 
-enum EdgeState : std::uint8_t { kOutOfHeap = 0, kInHeap = 1, kStale = 2, kDead = 3 };
 
 // The best collapse of one edge, as last evaluated.
 struct Candidate {
@@ -208,24 +213,12 @@ class Decimator {
   }
   bool evaluate(Edge e, Candidate& c) const;
   double boundary_shift(Halfedge h0, const Vec3d& p) const;
-  void push(Edge e, float cost) { heap_.push(cost, e.idx()); }
-  // Re-evaluates e and queues it; an edge without any legal placement stays out.
+  // Evaluates e and queues it under a new version (any older entry becomes stale); an edge
+  // without any legal placement just loses its entries.
   void requeue(Edge e) {
+    const std::uint8_t v = ++version_[e.idx()];
     Candidate c;
-    if (evaluate(e, c)) {
-      state_[e.idx()] = kInHeap;
-      push(e, c.cost);
-    } else {
-      state_[e.idx()] = kOutOfHeap;
-    }
-  }
-  // The edge's endpoints changed: its queued cost is now a lower bound (quadrics only grow).
-  void touch(Edge e) {
-    std::uint8_t& state = state_[e.idx()];
-    if (state == kInHeap)
-      state = kStale;
-    else if (state == kOutOfHeap)
-      requeue(e);
+    if (evaluate(e, c)) queue_.push(EdgeQueue::key(c.cost, v), e.idx());
   }
 
   // ---- collapsing ----------------------------------------------------------------------
@@ -256,8 +249,8 @@ class Decimator {
     std::uint8_t flags = 0;
   };
   std::vector<VertexData> vd_;
-  std::vector<std::uint8_t> state_;  // EdgeState per edge: one byte, so touching edges stays in cache
-  EdgeQueue heap_;
+  std::vector<std::uint8_t> version_;  // of each edge's current queue entry: one byte, stays in cache
+  EdgeQueue queue_;
   struct RingEntry {
     Vertex vertex;  // a neighbour, in counter-clockwise order
     Face face;      // the face between it and the next neighbour (invalid: a hole)
@@ -528,16 +521,13 @@ bool Decimator::evaluate(Edge e, Candidate& c) const {
 }
 
 void Decimator::fill_heap() {
-  state_.assign(m_.edges_size(), kOutOfHeap);
-  heap_.clear();
+  version_.assign(m_.edges_size(), 0);
+  queue_.clear();
   std::size_t done = 0;
   const double total = double(std::max<std::size_t>(1, m_.n_edges()));
   for (Edge e : m_.edges()) {
     Candidate c;
-    if (evaluate(e, c)) {
-      state_[e.idx()] = kInHeap;
-      heap_.push(c.cost, e.idx());
-    }
+    if (evaluate(e, c)) queue_.push(EdgeQueue::key(c.cost, 0), e.idx());
     if ((++done & 0xffff) == 0) progress_.update(0.1 * done / total, "measuring edges");
   }
 }
@@ -754,9 +744,9 @@ bool Decimator::collapse(Halfedge h, const Candidate& c) {
     // has changed yet (gather_wedges only reads) and the edge is simply skipped.
     return false;
   }
-  // Queue entries of deleted edges are dropped when they surface, by this mark alone.
+  // Queue entries of deleted edges go stale.
   for (Edge d : doomed)
-    if (m_.is_deleted(d)) state_[d.idx()] = kDead;
+    if (m_.is_deleted(d)) ++version_[d.idx()];
   m_.position(v1) = c.position;
 #ifdef HEDGE_DECIMATE_DEBUG
   if (Validation val = validate(m_); !val.ok)
@@ -786,11 +776,15 @@ bool Decimator::collapse(Halfedge h, const Candidate& c) {
       const std::uint8_t f = std::uint8_t((vd_[v.idx()].flags & ~kSeamBits) | classify(v));
       if (f != vd_[v.idx()].flags) {
         vd_[v.idx()].flags = f;
-        for (Halfedge x : m_.outgoing(v)) touch(Mesh::edge(x));
+        for (Halfedge x : m_.outgoing(v)) requeue(Mesh::edge(x));
       }
     }
   }
-  for (Halfedge x : m_.outgoing(v1)) touch(Mesh::edge(x));
+  // Every edge at the kept vertex changed: evaluate them now, while their half-edges are in
+  // cache (one sweep to fetch the neighbours' data, one to evaluate), rather than when they
+  // surface cold.
+  for (Halfedge x : m_.outgoing(v1)) __builtin_prefetch(&vd_[m_.to_vertex(x).idx()]);
+  for (Halfedge x : m_.outgoing(v1)) requeue(Mesh::edge(x));
   return true;
 }
 
@@ -828,31 +822,23 @@ DecimateReport Decimator::run() {
   std::size_t collapses_since_fill = 0, refills = 0;
   std::size_t steps = 0;
   while (faces_ > target_) {
-    if (heap_.empty()) {
+    if (queue_.empty()) {
       // Edges refused earlier (fold-overs, link condition) may be legal now that their
       // neighbourhood changed: queue every edge again while that still helps.
       if (collapses_since_fill == 0 || (faces_ == target_ + 1 && skipped_for_parity_) || ++refills > 4) break;
       collapses_since_fill = 0;
-      for (Edge e : m_.edges())
-        if (state_[e.idx()] == kOutOfHeap) requeue(e);
+      for (Edge e : m_.edges()) requeue(e);
       continue;
     }
     if ((++steps & 0x3ff) == 0)
       progress_.update(0.1 + 0.85 * double(start_faces - faces_) / double(to_remove), "collapsing edges");
 
-    const Edge e(heap_.top());
-    heap_.pop();
-    std::uint8_t& state = state_[e.idx()];
-    if (state == kDead) continue;
-    if (state == kStale) {
-      // Its cost only grew (a lower bound was queued): queue it again at its true cost; if
-      // it is still the cheapest it surfaces again at once.
-      requeue(e);
-      continue;
-    }
-    state = kOutOfHeap;
-    // Current: its placement is computed again rather than stored, which keeps the per-edge
-    // state to one byte; the vertex data it reads is needed for the collapse anyway.
+    const EdgeQueue::Entry entry = queue_.pop();
+    const Edge e(entry.edge);
+    if (EdgeQueue::version(entry.key) != version_[e.idx()] || m_.is_deleted(e)) continue;
+    ++version_[e.idx()];  // out of the queue now
+    // Its placement is computed again rather than stored, which keeps the per-edge state to
+    // one byte; the vertex data it reads is needed for the collapse anyway.
     Candidate c;
     if (!evaluate(e, c)) continue;
 
