@@ -2,9 +2,9 @@
 // fresh MeshLab mesh. See cmesh_soup.h.
 #include "cmesh_soup.h"
 
-#include <vcg/complex/allocate.h>
 #include <vcg/complex/algorithms/update/bounding.h>
 #include <vcg/complex/algorithms/update/normal.h>
+#include <vcg/complex/allocate.h>
 
 #include <algorithm>
 #include <cstdint>
@@ -25,9 +25,12 @@ constexpr std::uint32_t kNoIndex = std::numeric_limits<std::uint32_t>::max();
 // collide with them and are left out.
 bool is_standard_channel(const std::string& name, Domain domain) {
   switch (domain) {
-    case Domain::vertex: return name == "normal" || name == "color" || name == "quality" || name == "uv" || name == "selected";
-    case Domain::face: return name == "color" || name == "quality" || name == "selected" || name == "material";
-    case Domain::corner: return name == "uv";
+    case Domain::vertex:
+      return name == "normal" || name == "color" || name == "quality" || name == "uv" || name == "selected";
+    case Domain::face:
+      return name == "color" || name == "quality" || name == "selected" || name == "material";
+    case Domain::corner:
+      return name == "uv";
   }
   return false;
 }
@@ -66,7 +69,8 @@ void read_attributes(const std::set<vcg::PointerToAttribute>& attributes, Domain
       channel.components = static_cast<int>(size);
       channel.data.resize(live.size() * size);
     }
-    for (std::size_t i = 0; i < live.size(); ++i) std::memcpy(channel.data.data() + i * size, handle->At(live[i]), size);
+    for (std::size_t i = 0; i < live.size(); ++i)
+      std::memcpy(channel.data.data() + i * size, handle->At(live[i]), size);
   }
 }
 
@@ -103,12 +107,14 @@ std::vector<vcg::Color4b> colors_of(const Soup& soup, Domain domain) {
   const std::size_t n = soup.domain_size(domain);
   if (const auto* bytes = typed_channel<std::uint8_t>(soup, "color", domain, ScalarType::u8, 4)) {
     colors.resize(n);
-    for (std::size_t i = 0; i < n; ++i) colors[i] = vcg::Color4b(bytes[4 * i], bytes[4 * i + 1], bytes[4 * i + 2], bytes[4 * i + 3]);
+    for (std::size_t i = 0; i < n; ++i)
+      colors[i] = vcg::Color4b(bytes[4 * i], bytes[4 * i + 1], bytes[4 * i + 2], bytes[4 * i + 3]);
   } else if (const auto* floats = typed_channel<float>(soup, "color", domain, ScalarType::f32, 4)) {
     colors.resize(n);
     auto byte = [](float x) { return static_cast<unsigned char>(std::clamp(x, 0.0f, 1.0f) * 255.0f + 0.5f); };
     for (std::size_t i = 0; i < n; ++i)
-      colors[i] = vcg::Color4b(byte(floats[4 * i]), byte(floats[4 * i + 1]), byte(floats[4 * i + 2]), byte(floats[4 * i + 3]));
+      colors[i] =
+          vcg::Color4b(byte(floats[4 * i]), byte(floats[4 * i + 1]), byte(floats[4 * i + 2]), byte(floats[4 * i + 3]));
   }
   return colors;
 }
@@ -133,7 +139,7 @@ void gather_polygons(const CMeshO& m, const std::vector<std::size_t>& triangles,
     while (parent[t] != t) t = parent[t] = parent[parent[t]];
     return t;
   };
-  std::vector<std::uint8_t> joined(3 * n, 0);  // this faux edge joins two triangles
+  std::vector<std::uint8_t> joined(3 * n, 0);                // this faux edge joins two triangles
   std::unordered_map<std::uint64_t, std::uint32_t> waiting;  // faux edge -> the first triangle side met
   constexpr std::uint32_t kTaken = kNoIndex;
   for (std::size_t t = 0; t < n; ++t)
@@ -154,7 +160,8 @@ void gather_polygons(const CMeshO& m, const std::vector<std::size_t>& triangles,
   for (std::size_t t = 0; t < n; ++t) ++group_start[root(static_cast<std::uint32_t>(t)) + 1];
   for (std::size_t r = 0; r < n; ++r) group_start[r + 1] += group_start[r];
   std::vector<std::uint32_t> fill(group_start.begin(), group_start.end() - 1);
-  for (std::size_t t = 0; t < n; ++t) members[fill[root(static_cast<std::uint32_t>(t))]++] = static_cast<std::uint32_t>(t);
+  for (std::size_t t = 0; t < n; ++t)
+    members[fill[root(static_cast<std::uint32_t>(t))]++] = static_cast<std::uint32_t>(t);
 
   auto emit_triangle = [&](std::uint32_t t) {
     live_faces.push_back(triangles[t]);
@@ -321,7 +328,8 @@ Soup soup_from_mesh(const MeshModel& model) {
       uv[2 * c] = wedge.U();
       uv[2 * c + 1] = wedge.V();
     }
-    const bool textured = std::any_of(live_faces.begin(), live_faces.end(), [&](std::size_t i) { return m.face[i].cWT(0).N() != 0; });
+    const bool textured =
+        std::any_of(live_faces.begin(), live_faces.end(), [&](std::size_t i) { return m.face[i].cWT(0).N() != 0; });
     // MeshLab keeps the texture index per wedge; hedge keeps one per face, the first wedge's.
     if (textured) {
       auto* material = soup.add_channel("material", Domain::face, ScalarType::i32, 1).as<std::int32_t>();
@@ -380,8 +388,9 @@ MeshWriteReport write_soup_to_mesh(const Soup& result, const Soup& input, MeshMo
   if (corner_uv) carried |= MeshModel::MM_WEDGTEXCOORD;
   if (report.polygons_triangulated) carried |= MeshModel::MM_POLYGONAL;
   // Attribute data the result does not carry, and derived data the new mesh would make stale.
-  int dropped = (MeshModel::MM_VERTCOLOR | MeshModel::MM_VERTQUALITY | MeshModel::MM_VERTTEXCOORD | MeshModel::MM_FACECOLOR |
-                 MeshModel::MM_FACEQUALITY | MeshModel::MM_WEDGTEXCOORD) & ~carried;
+  int dropped = (MeshModel::MM_VERTCOLOR | MeshModel::MM_VERTQUALITY | MeshModel::MM_VERTTEXCOORD |
+                 MeshModel::MM_FACECOLOR | MeshModel::MM_FACEQUALITY | MeshModel::MM_WEDGTEXCOORD) &
+                ~carried;
   dropped |= MeshModel::MM_FACEFACETOPO | MeshModel::MM_VERTFACETOPO;
   if (report.geometry_changed)
     dropped |= MeshModel::MM_VERTCURV | MeshModel::MM_VERTCURVDIR | MeshModel::MM_FACECURVDIR;
@@ -438,7 +447,8 @@ MeshWriteReport write_soup_to_mesh(const Soup& result, const Soup& input, MeshMo
   vcg::tri::UpdateBounding<CMeshO>::Box(m);
   if (nt > 0) vcg::tri::UpdateNormal<CMeshO>::PerFaceNormalized(m);
   if (normals && (!report.geometry_changed || nt == 0)) {
-    for (std::size_t i = 0; i < nv; ++i) m.vert[i].N() = Point3m(normals[3 * i], normals[3 * i + 1], normals[3 * i + 2]);
+    for (std::size_t i = 0; i < nv; ++i)
+      m.vert[i].N() = Point3m(normals[3 * i], normals[3 * i + 1], normals[3 * i + 2]);
   } else if (nt > 0) {
     vcg::tri::UpdateNormal<CMeshO>::PerVertexAngleWeighted(m);  // as MeshModel::UpdateBoxAndNormals
   }

@@ -19,7 +19,7 @@ namespace hedge::meshlab {
 Soup soup_from_mesh(const MeshModel& model);
 
 struct MeshWriteReport {
-  bool geometry_changed = true;        //!< positions or connectivity differ from the input soup
+  bool geometry_changed = true;           //!< positions or connectivity differ from the input soup
   std::size_t polygons_triangulated = 0;  //!< faces of more than 3 corners, stored as faux-edge fans
   std::size_t edges_dropped = 0;          //!< vcg edge elements (wireframe) the fresh mesh has no place for
 };

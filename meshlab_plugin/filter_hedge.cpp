@@ -28,10 +28,14 @@ std::map<std::string, hedge::Value> given_values(const hedge::Operation& op, con
     const QString name = QString::fromStdString(spec.id);
     if (!parameters.hasParameter(name)) continue;
     const ::Value& value = parameters.getParameterByName(name).value();
-    if (value.isBool()) given[spec.id] = value.getBool();
-    else if (value.isEnum() || value.isInt()) given[spec.id] = static_cast<std::int64_t>(value.getInt());
-    else if (value.isFloat()) given[spec.id] = hedge::meshlab::real_from_float(value.getFloat());
-    else given[spec.id] = value.typeName().toStdString();  // a type hedge never declares: refused by name
+    if (value.isBool())
+      given[spec.id] = value.getBool();
+    else if (value.isEnum() || value.isInt())
+      given[spec.id] = static_cast<std::int64_t>(value.getInt());
+    else if (value.isFloat())
+      given[spec.id] = hedge::meshlab::real_from_float(value.getFloat());
+    else
+      given[spec.id] = value.typeName().toStdString();  // a type hedge never declares: refused by name
   }
   return given;
 }
@@ -72,7 +76,9 @@ void FilterHedgePlugin::initParameterSet(QAction* action, MeshModel&, RichParame
     const QString name = QString::fromStdString(spec.id), label = QString::fromStdString(spec.label);
     const QString tooltip = hedge::meshlab::param_tooltip(spec);
     switch (hedge::meshlab::rich_kind(spec)) {
-      case RichKind::boolean: parameters.addParam(RichBool(name, spec.default_value != 0, label, tooltip)); break;
+      case RichKind::boolean:
+        parameters.addParam(RichBool(name, spec.default_value != 0, label, tooltip));
+        break;
       case RichKind::integer:
         parameters.addParam(RichInt(name, hedge::meshlab::int_bound(spec.default_value), label, tooltip));
         break;

@@ -32,23 +32,31 @@ int filter_class(const Operation& op) {
 
 RichKind rich_kind(const ParamSpec& spec) {
   switch (spec.type) {
-    case ParamType::boolean: return RichKind::boolean;
-    case ParamType::integer: return RichKind::integer;
-    case ParamType::choice: return RichKind::choice;
+    case ParamType::boolean:
+      return RichKind::boolean;
+    case ParamType::integer:
+      return RichKind::integer;
+    case ParamType::choice:
+      return RichKind::choice;
     case ParamType::real:
       return std::isfinite(spec.min) && std::isfinite(spec.max) && spec.max - spec.min <= 1e6 ? RichKind::bounded_real
-                                                                                             : RichKind::real;
+                                                                                              : RichKind::real;
   }
   return RichKind::real;
 }
 
 const char* rich_type_name(RichKind kind) {
   switch (kind) {
-    case RichKind::boolean: return "RichBool";
-    case RichKind::integer: return "RichInt";
-    case RichKind::real: return "RichFloat";
-    case RichKind::bounded_real: return "RichDynamicFloat";
-    case RichKind::choice: return "RichEnum";
+    case RichKind::boolean:
+      return "RichBool";
+    case RichKind::integer:
+      return "RichInt";
+    case RichKind::real:
+      return "RichFloat";
+    case RichKind::bounded_real:
+      return "RichDynamicFloat";
+    case RichKind::choice:
+      return "RichEnum";
   }
   return "RichFloat";
 }
@@ -89,7 +97,9 @@ QStringList run_on_model(const Operation& op, const std::map<std::string, Value>
   });
 
   using Clock = std::chrono::steady_clock;
-  const auto seconds_since = [](Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); };
+  const auto seconds_since = [](Clock::time_point start) {
+    return std::chrono::duration<double>(Clock::now() - start).count();
+  };
   auto start = Clock::now();
   const Soup input = soup_from_mesh(model);
   const double read_seconds = seconds_since(start);

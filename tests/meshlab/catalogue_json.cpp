@@ -38,17 +38,18 @@ int main() {
   bool first_op = true;
   for (const Operation& op : catalogue()) {
     out += std::string(first_op ? "" : ",") + "\n  {\"id\": " + quoted(op.id) + ", \"title\": " + quoted(op.title) +
-           ", \"filter\": " + quoted(meshlab::filter_name(op).toStdString()) + ", \"category\": " + quoted(op.category) +
+           ", \"filter\": " + quoted(meshlab::filter_name(op).toStdString()) +
+           ", \"category\": " + quoted(op.category) +
            ", \"filter_class\": " + std::to_string(meshlab::filter_class(op)) +
            ", \"changes_mesh\": " + (op.changes_mesh ? "true" : "false") + ", \"params\": [";
     first_op = false;
     bool first_param = true;
     for (const ParamSpec& p : op.params) {
-      out += std::string(first_param ? "" : ",") + "\n    {\"id\": " + quoted(p.id) + ", \"label\": " + quoted(p.label) +
-             ", \"type\": " + quoted(param_type_name(p.type)) +
+      out += std::string(first_param ? "" : ",") + "\n    {\"id\": " + quoted(p.id) +
+             ", \"label\": " + quoted(p.label) + ", \"type\": " + quoted(param_type_name(p.type)) +
              ", \"rich_type\": " + quoted(meshlab::rich_type_name(meshlab::rich_kind(p))) +
-             ", \"default\": " + number(p.default_value) + ", \"min\": " + number(p.min) + ", \"max\": " + number(p.max) +
-             ", \"choices\": [";
+             ", \"default\": " + number(p.default_value) + ", \"min\": " + number(p.min) +
+             ", \"max\": " + number(p.max) + ", \"choices\": [";
       first_param = false;
       for (std::size_t i = 0; i < p.choices.size(); ++i) out += (i ? ", " : "") + quoted(p.choices[i]);
       out += "]}";

@@ -8,8 +8,8 @@
 #include <vcg/complex/allocate.h>
 
 #include <QApplication>
-#include <algorithm>
 #include <QPluginLoader>
+#include <algorithm>
 #include <cstdlib>
 #include <map>
 #include <string>
@@ -144,7 +144,8 @@ TEST_F(PluginTest, OneFilterPerOperationWithCatalogueParameters) {
     ASSERT_NE(action, nullptr) << op.id;
     RichParameterList parameters = doc.defaults(action);
     EXPECT_EQ(static_cast<std::size_t>(parameters.size()), op.params.size()) << op.id;
-    for (const hedge::ParamSpec& p : op.params) EXPECT_TRUE(parameters.hasParameter(QString::fromStdString(p.id))) << p.id;
+    for (const hedge::ParamSpec& p : op.params)
+      EXPECT_TRUE(parameters.hasParameter(QString::fromStdString(p.id))) << p.id;
     EXPECT_FALSE(hedge_plugin->filterInfo(action).isEmpty());
   }
 }
@@ -284,7 +285,8 @@ TEST_F(PluginTest, PolygonsComeBackAsFauxEdgeFans) {
   CMeshO& m = doc.model->cm;
   EXPECT_EQ(m.fn, 6 * 3674);
   EXPECT_TRUE(doc.model->hasDataMask(MeshModel::MM_POLYGONAL));
-  for (const CFaceO& f : m.face) EXPECT_EQ(int(f.IsF(0)) + int(f.IsF(1)) + int(f.IsF(2)), 1) << "one diagonal per quad half";
+  for (const CFaceO& f : m.face)
+    EXPECT_EQ(int(f.IsF(0)) + int(f.IsF(1)) + int(f.IsF(2)), 1) << "one diagonal per quad half";
 }
 
 TEST_F(PluginTest, PolygonsSurviveAChainOfFilters) {
