@@ -62,14 +62,16 @@ class Target:
     def write(self):
         if self.result is not None:
             if self.edit:
-                exchange.write_mesh(self.scratch, self.data, self.result)
+                messages = exchange.write_mesh(self.scratch, self.data, self.result)
                 bm = bmesh.from_edit_mesh(self.obj.data)
                 bm.clear()
                 bm.from_mesh(self.scratch)
                 bmesh.update_edit_mesh(self.obj.data, loop_triangles=True, destructive=True)
             else:
-                exchange.write_mesh(self.obj.data, self.data, self.result)
+                messages = exchange.write_mesh(self.obj.data, self.data, self.result)
                 self.obj.data.update()
+            if self.report is not None:
+                self.report.setdefault("messages", []).extend(messages)
         self.release()
 
     def release(self):

@@ -285,13 +285,25 @@ def _write_edges(me, data, result):
         _set(attr.data, prop, out)
 
 
+def repeated_vertex_faces(sizes, corners):
+    """Faces that visit a vertex twice in a row (all such triangles), which Blender must not hold."""
+    if len(sizes) == 0:
+        return 0
+    starts = np.zeros(len(sizes), np.int64)
+    np.cumsum(sizes[:-1], out=starts[1:])
+    nxt = np.arange(1, len(corners) + 1)
+    nxt[starts + sizes - 1] = starts
+    repeat = corners == corners[nxt]
+    return int(np.count_nonzero(np.add.reduceat(repeat, starts)))
+
+
 def write_mesh(me, data, result, rebuild=False):
     """Writes a result dict into `me`. Same topology: in place (unless `rebuild`). Otherwise
     the geometry is rebuilt and every layer recreated from its channel."""
     if not rebuild and same_topology(data.soup, result):
         _write_channels_in_place(me, data, result)
         me.update()
-        return
+        return []
     positions = result["positions"]
     sizes = result["face_sizes"]
     corners = result["corners"]
@@ -310,7 +322,14 @@ def write_mesh(me, data, result, rebuild=False):
     me.update(calc_edges=True)
     _write_attributes(me, data, result, create=True)
     _write_edges(me, data, result)
+    messages = []
+    bad = repeated_vertex_faces(sizes, corners)
+    if bad:
+        # Never leave Blender a face that repeats a vertex; validate() (slow) only then.
+        me.validate(clean_customdata=False)
+        messages.append(f"Blender: removed {bad} faces that repeat a vertex (validate)")
     me.update()
+    return messages
 
 
 def write_new(me, soup):
@@ -328,5 +347,5 @@ def write_new(me, soup):
             data.active_uv = data.render_uv = "UVMap"
     result = dict(soup, channels=channels)
     if nf == 0 and len(soup["positions"]) == 0:
-        return
-    write_mesh(me, data, result)
+        return []
+    return write_mesh(me, data, result)

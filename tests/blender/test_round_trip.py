@@ -92,11 +92,10 @@ class RoundTripTest(unittest.TestCase):
     def test_operator_no_change_keeps_vertex_groups(self):
         obj = add_primitive("monkey")
         decorate(obj)
+        bpy.ops.mesh.hedge_triangulate()
         vg = obj.vertex_groups.new(name="g")
         vg.add([1, 2, 3], 0.5, 'REPLACE')
-        before = mesh_arrays(obj.data)
-        # triangulate on triangles only: the topology stays, so the mesh is written in place.
-        bpy.ops.mesh.hedge_triangulate()
+        # triangulate on triangles: the topology stays, so the mesh is written in place.
         bpy.ops.mesh.hedge_triangulate()
         before = mesh_arrays(obj.data)
         bpy.ops.mesh.hedge_triangulate()
