@@ -107,7 +107,7 @@ struct Quality {
   double hausdorff = 0;  // symmetric, relative to the input's bounding-box diagonal
 };
 
-Quality measure(const Mesh& input, const Mesh& out, double target) {
+Quality measure(const Mesh& input, const Mesh& out, double target, double sample_density = 4) {
   Quality q;
   std::size_t in = 0;
   for (Edge e : out.edges()) {
@@ -116,7 +116,9 @@ Quality measure(const Mesh& input, const Mesh& out, double target) {
   }
   q.in_band = double(in) / double(out.n_edges());
   q.stats = mesh_statistics(out);
-  q.hausdorff = hausdorff(input, out).max / mesh_statistics(input).bbox_diagonal;
+  HausdorffOptions options;
+  options.sample_density = sample_density;
+  q.hausdorff = hausdorff(input, out, options).max / mesh_statistics(input).bbox_diagonal;
   return q;
 }
 
@@ -468,7 +470,7 @@ TEST(Remesh, DragonFigures) {
     RemeshReport report = remesh(mesh, options);
     double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     expect_valid(mesh);
-    Quality q = measure(input, mesh, report.target_edge_length);
+    Quality q = measure(input, mesh, report.target_edge_length, 1);
     std::printf(
         "[ figures  ] %s: %zu -> %zu faces, 3 iterations in %.2f s (%zu splits, %zu collapses, %zu flips); "
         "in band %.1f%%; mean min angle %.1f deg; irregular %.1f%%; Hausdorff %.4f%% of the diagonal\n",

@@ -129,6 +129,7 @@ class Remesher {
   }
   bool star_ok(Vertex v, Vertex other, const Vec3d& target) const;
   bool may_collapse(Halfedge h, const Vec3d& target) const;
+  bool flip_if_better(Edge e);
   void grow_vertex_arrays();
 
   // The input halfedges whose targets are the corners of surface triangle t, in the order
@@ -148,7 +149,11 @@ class Remesher {
 
   std::vector<std::uint8_t> edge_flags_;
   std::vector<Kind> kind_;
-  std::vector<int> valence_;
+  struct Degree {
+    std::int32_t valence = 0, target = 6;  // target: 6 inside, 4 on the boundary
+  };
+  std::vector<Degree> degree_;
+  std::vector<Edge> work_;  // pending edges of the collapse and flip passes
   std::vector<Index> surface_hint_, curve_hint_;
   std::vector<double> sizing_;                 // per vertex, adaptive only
   std::vector<double> input_sizing_;           // per input vertex, adaptive only
@@ -168,7 +173,7 @@ std::array<Halfedge, 3> Remesher::input_corners(Index t) const {
 void Remesher::grow_vertex_arrays() {
   const std::size_t n = mesh_.vertices_size();
   kind_.resize(n, Kind::free);
-  valence_.resize(n, 0);
+  degree_.resize(n);
   surface_hint_.resize(n, kInvalidIndex);
   curve_hint_.resize(n, kInvalidIndex);
   if (options_.adaptive) sizing_.resize(n, length_);
@@ -228,7 +233,7 @@ void Remesher::classify() {
   // spot) must stay together to be welded back, so they are fixed too.
   const std::size_t nv = mesh_.vertices_size();
   kind_.assign(nv, Kind::free);
-  valence_.assign(nv, 0);
+  degree_.assign(nv, Degree{});
   std::vector<std::uint32_t> copies;
   const TypedArray<std::uint32_t>* source = mesh_.vertex_properties().get<std::uint32_t>("hedge:source");
   if (source) {
@@ -247,7 +252,7 @@ void Remesher::classify() {
       pinned += (f & kPinned) ? 1 : 0;
       ++valence;
     }
-    valence_[v.idx()] = valence;
+    degree_[v.idx()] = {valence, mesh_.is_boundary(v) ? 4 : 6};
     Kind k = Kind::free;
     if (mesh_.is_isolated(v) || pinned > 0 || (curve != 0 && curve != 2))
       k = Kind::fixed;
@@ -375,9 +380,9 @@ void Remesher::split_long_edges() {
       edge_flags_[Mesh::edge(mesh_.find_halfedge(v, b)).idx()] = flags;
       grow_vertex_arrays();
       kind_[v.idx()] = kind_of_new_vertex(flags);
-      valence_[v.idx()] = 2 + (c.is_valid() ? 1 : 0) + (d.is_valid() ? 1 : 0);
-      if (c.is_valid()) ++valence_[c.idx()];
-      if (d.is_valid()) ++valence_[d.idx()];
+      degree_[v.idx()] = {2 + (c.is_valid() ? 1 : 0) + (d.is_valid() ? 1 : 0), c.is_valid() && d.is_valid() ? 6 : 4};
+      if (c.is_valid()) ++degree_[c.idx()].valence;
+      if (d.is_valid()) ++degree_[d.idx()].valence;
       surface_hint_[v.idx()] = surface_hint_[a.idx()];
       curve_hint_[v.idx()] = curve_hint_[a.idx()] != kInvalidIndex ? curve_hint_[a.idx()] : curve_hint_[b.idx()];
       if (!sizing_.empty()) sizing_[v.idx()] = 0.5 * (sizing_[a.idx()] + sizing_[b.idx()]);
@@ -422,101 +427,146 @@ bool Remesher::may_collapse(Halfedge h, const Vec3d& target) const {
   return mesh_.is_collapse_ok(h);
 }
 
+// One pass over all edges, then the edges at each vertex a collapse moved, until none is
+// short and collapsible (every collapse removes a vertex, so it ends).
 void Remesher::collapse_short_edges() {
-  for (int pass = 0; pass < 3; ++pass) {
-    std::size_t collapsed = 0;
-    for (Index i = 0; i < mesh_.edges_size(); ++i) {
-      const Edge e(i);
-      if (mesh_.is_deleted(e) || (edge_flags_[i] & kFeature)) continue;
-      Halfedge h = Mesh::halfedge(e, 0), o = Mesh::halfedge(e, 1);
-      Vertex a = mesh_.from_vertex(h), b = mesh_.to_vertex(h);
-      double lo = 0.8 * size(a, b);
-      if (length_sq(a, b) >= lo * lo) continue;
-      // Botsch & Kobbelt collapse to the midpoint, which leaves shorter edges than keeping
-      // an end; an end that may not move (fixed, or sliding off its curve) is kept instead.
-      const bool curve_edge = edge_flags_[i] & kCurve;
-      auto movable = [&](Vertex v) {
-        return kind_[v.idx()] == Kind::free || (kind_[v.idx()] == Kind::sliding && curve_edge);
-      };
-      const Vec3d pa = to_double(mesh_.position(a)), pb = to_double(mesh_.position(b));
-      const bool midpoint = movable(a) && movable(b);
-      const Vec3d mid = (pa + pb) * 0.5;
-      bool remove_a = may_collapse(h, midpoint ? mid : pb), remove_b = may_collapse(o, midpoint ? mid : pa);
-      if (!remove_a && !remove_b) continue;
-      // Both ways possible: remove the vertex of lower valence (pmp-library's choice).
-      const Halfedge c = remove_a && (!remove_b || valence_[a.idx()] <= valence_[b.idx()]) ? h : o;
-      const Halfedge co = Mesh::opposite(c);
-      const Vertex gone = mesh_.from_vertex(c), kept = mesh_.to_vertex(c);
-
-      // The two triangles at the edge collapse: each merges its other two edges into the
-      // one at the kept vertex, which inherits the flags of the one that goes.
-      Vertex left = mesh_.is_boundary(c) ? Vertex() : mesh_.to_vertex(mesh_.next(c));
-      Vertex right = mesh_.is_boundary(co) ? Vertex() : mesh_.to_vertex(mesh_.next(co));
-      Edge left_kept, left_gone, right_kept, right_gone;
-      if (left.is_valid()) left_kept = Mesh::edge(mesh_.next(c)), left_gone = Mesh::edge(mesh_.prev(c));
-      if (right.is_valid()) right_kept = Mesh::edge(mesh_.prev(co)), right_gone = Mesh::edge(mesh_.next(co));
-      // Corners of the removed vertex's other faces move to the kept vertex: they take the
-      // kept vertex's corner of a collapsing triangle (same chart: the edge is no seam).
-      // Done before the collapse, which moves some of them onto surviving half-edges.
-      if (!corner_arrays_.empty()) {
-        const Halfedge source = left.is_valid() ? c : mesh_.prev(co);
-        for (Halfedge g : mesh_.outgoing(gone)) {
-          Halfedge in = Mesh::opposite(g);
-          if (mesh_.is_boundary(in) || in == mesh_.prev(c) || in == co) continue;
-          for (PropertyArray* p : corner_arrays_) p->copy_element(source.idx(), in.idx());
-        }
-      }
-      if (midpoint) {
-        const Index from[2] = {kept.idx(), gone.idx()};
-        const float half[2] = {0.5f, 0.5f};
-        for (PropertyArray* p : vertex_arrays_) p->interpolate(kept.idx(), from, half);
-        if (!sizing_.empty()) sizing_[kept.idx()] = 0.5 * (sizing_[kept.idx()] + sizing_[gone.idx()]);
-      }
-
-      mesh_.collapse(c);
-      if (midpoint) mesh_.position(kept) = to_float(mid);
-      if (left.is_valid()) edge_flags_[left_kept.idx()] |= edge_flags_[left_gone.idx()];
-      if (right.is_valid()) edge_flags_[right_kept.idx()] |= edge_flags_[right_gone.idx()];
-      valence_[kept.idx()] = static_cast<int>(mesh_.valence(kept));
-      if (left.is_valid()) valence_[left.idx()] = static_cast<int>(mesh_.valence(left));
-      if (right.is_valid()) valence_[right.idx()] = static_cast<int>(mesh_.valence(right));
-      ++collapsed;
+  std::vector<Edge>& pending = work_;
+  pending.clear();
+  Index next_edge = 0;
+  for (;;) {
+    Edge e;
+    if (!pending.empty()) {
+      e = pending.back();
+      pending.pop_back();
+    } else if (next_edge < mesh_.edges_size()) {
+      e = Edge(next_edge++);
+    } else {
+      break;
     }
-    report_.collapses += collapsed;
-    if (collapsed == 0) break;
+    const Index i = e.idx();
+    if (mesh_.is_deleted(e) || (edge_flags_[i] & kFeature)) continue;
+    Halfedge h = Mesh::halfedge(e, 0), o = Mesh::halfedge(e, 1);
+    Vertex a = mesh_.from_vertex(h), b = mesh_.to_vertex(h);
+    double lo = 0.8 * size(a, b);
+    if (length_sq(a, b) >= lo * lo) continue;
+    // Botsch & Kobbelt collapse to the midpoint, which leaves shorter edges than keeping
+    // an end; an end that may not move (fixed, or sliding off its curve) is kept instead.
+    const bool curve_edge = edge_flags_[i] & kCurve;
+    auto movable = [&](Vertex v) {
+      return kind_[v.idx()] == Kind::free || (kind_[v.idx()] == Kind::sliding && curve_edge);
+    };
+    const Vec3d pa = to_double(mesh_.position(a)), pb = to_double(mesh_.position(b));
+    const bool midpoint = movable(a) && movable(b);
+    const Vec3d mid = (pa + pb) * 0.5;
+    // Remove the vertex of lower valence when both ways are possible (pmp-library's
+    // choice): try that way first, the other only when it fails.
+    const bool a_first = degree_[a.idx()].valence <= degree_[b.idx()].valence;
+    const Halfedge first = a_first ? h : o, second = a_first ? o : h;
+    const Vec3d& first_target = midpoint ? mid : (a_first ? pb : pa);
+    const Vec3d& second_target = midpoint ? mid : (a_first ? pa : pb);
+    Halfedge c;
+    if (may_collapse(first, first_target))
+      c = first;
+    else if (may_collapse(second, second_target))
+      c = second;
+    else
+      continue;
+    const Halfedge co = Mesh::opposite(c);
+    const Vertex gone = mesh_.from_vertex(c), kept = mesh_.to_vertex(c);
+
+    // The two triangles at the edge collapse: each merges its other two edges into the
+    // one at the kept vertex, which inherits the flags of the one that goes.
+    Vertex left = mesh_.is_boundary(c) ? Vertex() : mesh_.to_vertex(mesh_.next(c));
+    Vertex right = mesh_.is_boundary(co) ? Vertex() : mesh_.to_vertex(mesh_.next(co));
+    Edge left_kept, left_gone, right_kept, right_gone;
+    if (left.is_valid()) left_kept = Mesh::edge(mesh_.next(c)), left_gone = Mesh::edge(mesh_.prev(c));
+    if (right.is_valid()) right_kept = Mesh::edge(mesh_.prev(co)), right_gone = Mesh::edge(mesh_.next(co));
+    // Corners of the removed vertex's other faces move to the kept vertex: they take the
+    // kept vertex's corner of a collapsing triangle (same chart: the edge is no seam).
+    // Done before the collapse, which moves some of them onto surviving half-edges.
+    if (!corner_arrays_.empty()) {
+      const Halfedge source = left.is_valid() ? c : mesh_.prev(co);
+      for (Halfedge g : mesh_.outgoing(gone)) {
+        Halfedge in = Mesh::opposite(g);
+        if (mesh_.is_boundary(in) || in == mesh_.prev(c) || in == co) continue;
+        for (PropertyArray* p : corner_arrays_) p->copy_element(source.idx(), in.idx());
+      }
+    }
+    if (midpoint) {
+      const Index from[2] = {kept.idx(), gone.idx()};
+      const float half[2] = {0.5f, 0.5f};
+      for (PropertyArray* p : vertex_arrays_) p->interpolate(kept.idx(), from, half);
+      if (!sizing_.empty()) sizing_[kept.idx()] = 0.5 * (sizing_[kept.idx()] + sizing_[gone.idx()]);
+    }
+
+    mesh_.collapse(c);
+    if (midpoint) mesh_.position(kept) = to_float(mid);
+    if (left.is_valid()) edge_flags_[left_kept.idx()] |= edge_flags_[left_gone.idx()];
+    if (right.is_valid()) edge_flags_[right_kept.idx()] |= edge_flags_[right_gone.idx()];
+    int valence = 0;
+    for (Halfedge g : mesh_.outgoing(kept)) {
+      ++valence;
+      pending.push_back(Mesh::edge(g));
+    }
+    degree_[kept.idx()].valence = valence;
+    degree_[kept.idx()].target = std::min(degree_[kept.idx()].target, degree_[gone.idx()].target);
+    if (left.is_valid()) --degree_[left.idx()].valence;
+    if (right.is_valid()) --degree_[right.idx()].valence;
+    ++report_.collapses;
   }
 }
 
-void Remesher::equalize_valences() {
-  auto target = [&](Vertex v) { return mesh_.is_boundary(v) ? 4 : 6; };
+// Whether flipping e brings the valences of its four vertices closer to their targets (6
+// inside, 4 on the boundary) and keeps the surface from folding; flips it if so.
+bool Remesher::flip_if_better(Edge e) {
+  const Index i = e.idx();
+  if (mesh_.is_deleted(e) || (edge_flags_[i] & kFeature) || mesh_.is_boundary(e)) return false;
+  Halfedge h0 = Mesh::halfedge(e, 0), h1 = Mesh::halfedge(e, 1);
+  Vertex a = mesh_.to_vertex(h0), b = mesh_.to_vertex(h1);
+  Vertex c = mesh_.to_vertex(mesh_.next(h0)), d = mesh_.to_vertex(mesh_.next(h1));
+  Degree& da = degree_[a.idx()];
+  Degree& db = degree_[b.idx()];
+  Degree& dc = degree_[c.idx()];
+  Degree& dd = degree_[d.idx()];
   auto sq = [](int x) { return x * x; };
-  for (int pass = 0; pass < 5; ++pass) {
-    std::size_t flipped = 0;
-    for (Index i = 0; i < mesh_.edges_size(); ++i) {
-      const Edge e(i);
-      if (mesh_.is_deleted(e) || (edge_flags_[i] & kFeature) || mesh_.is_boundary(e)) continue;
-      Halfedge h0 = Mesh::halfedge(e, 0), h1 = Mesh::halfedge(e, 1);
-      Vertex a = mesh_.to_vertex(h0), b = mesh_.to_vertex(h1);
-      Vertex c = mesh_.to_vertex(mesh_.next(h0)), d = mesh_.to_vertex(mesh_.next(h1));
-      int va = valence_[a.idx()], vb = valence_[b.idx()], vc = valence_[c.idx()], vd = valence_[d.idx()];
-      int ta = target(a), tb = target(b), tc = target(c), td = target(d);
-      int before = sq(va - ta) + sq(vb - tb) + sq(vc - tc) + sq(vd - td);
-      int after = sq(va - 1 - ta) + sq(vb - 1 - tb) + sq(vc + 1 - tc) + sq(vd + 1 - td);
-      if (after >= before) continue;
-      // The quad a c b d must stay a surface after the flip: both new triangles facing the
-      // way the old ones did.
-      Vec3d pa = to_double(mesh_.position(a)), pb = to_double(mesh_.position(b));
-      Vec3d pc = to_double(mesh_.position(c)), pd = to_double(mesh_.position(d));
-      Vec3d old_normal = cross(pa - pb, pc - pb) + cross(pb - pa, pd - pa);
-      Vec3d n1 = cross(pc - pa, pd - pa), n2 = cross(pb - pc, pd - pc);
-      if (!(dot(n1, n2) > 0 && dot(n1, old_normal) > 0 && dot(n2, old_normal) > 0)) continue;
-      if (!mesh_.is_flip_ok(e)) continue;
-      mesh_.flip(e);
-      --valence_[a.idx()], --valence_[b.idx()], ++valence_[c.idx()], ++valence_[d.idx()];
-      ++flipped;
+  int before =
+      sq(da.valence - da.target) + sq(db.valence - db.target) + sq(dc.valence - dc.target) + sq(dd.valence - dd.target);
+  int after = sq(da.valence - 1 - da.target) + sq(db.valence - 1 - db.target) + sq(dc.valence + 1 - dc.target) +
+              sq(dd.valence + 1 - dd.target);
+  if (after >= before) return false;
+  // The quad a c b d must stay a surface after the flip: both new triangles facing the
+  // way the old ones did.
+  Vec3d pa = to_double(mesh_.position(a)), pb = to_double(mesh_.position(b));
+  Vec3d pc = to_double(mesh_.position(c)), pd = to_double(mesh_.position(d));
+  Vec3d old_normal = cross(pa - pb, pc - pb) + cross(pb - pa, pd - pa);
+  Vec3d n1 = cross(pc - pa, pd - pa), n2 = cross(pb - pc, pd - pc);
+  if (!(dot(n1, n2) > 0 && dot(n1, old_normal) > 0 && dot(n2, old_normal) > 0)) return false;
+  if (!mesh_.is_flip_ok(e)) return false;
+  mesh_.flip(e);
+  --da.valence, --db.valence, ++dc.valence, ++dd.valence;
+  ++report_.flips;
+  return true;
+}
+
+// One pass over all edges, then the four edges around each flip, until no flip helps.
+// Every flip lowers the sum of squared valence deviations, so it ends.
+void Remesher::equalize_valences() {
+  std::vector<Edge>& pending = work_;
+  pending.clear();
+  auto push_quad = [&](Edge e) {
+    for (unsigned side = 0; side < 2; ++side) {
+      Halfedge h = Mesh::halfedge(e, side);
+      pending.push_back(Mesh::edge(mesh_.next(h)));
+      pending.push_back(Mesh::edge(mesh_.prev(h)));
     }
-    report_.flips += flipped;
-    if (flipped == 0) break;
+  };
+  for (Index i = 0; i < mesh_.edges_size(); ++i) {
+    if (flip_if_better(Edge(i))) push_quad(Edge(i));
+    while (!pending.empty()) {
+      Edge e = pending.back();
+      pending.pop_back();
+      if (flip_if_better(e)) push_quad(e);
+    }
   }
 }
 
@@ -648,7 +698,7 @@ void Remesher::resample_attributes() {
   parallel_for(mesh_.vertices_size(), [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
       const Vertex v(static_cast<Index>(i));
-      if (mesh_.is_deleted(v) || kind_[i] != Kind::free) continue;
+      if (mesh_.is_deleted(v) || kind_[i] == Kind::fixed) continue;
       ClosestPoint c = surface_.closest_point_with_hint(to_double(mesh_.position(v)), surface_hint_[i]);
       if (!c.found()) continue;
       auto corners = input_corners(c.triangle);
