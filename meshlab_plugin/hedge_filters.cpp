@@ -81,15 +81,16 @@ QStringList run_on_model(const Operation& op, const std::map<std::string, Value>
   const QString name = filter_name(op);
   const ParamValues values = resolve_params(op, given);  // refuses out-of-range values before any work
 
-  // MeshLab's callback takes whole percents and a C string that must outlive the call; calls
-  // that would change neither are skipped (both hosts redraw on each one).
+  // MeshLab's callback takes whole percents and a C string that must outlive the call. It is
+  // called when the stage changes and every 5 % within one: the GUI redraws on each call, and
+  // meshlabserver prints each (without a newline), so finer steps only add noise.
   std::string text;
   int last_percent = -1;
   std::string last_stage;
   Progress progress([&](double fraction, const std::string& stage) {
     if (cb == nullptr) return true;
     const int percent = std::clamp(static_cast<int>(fraction * 100.0), 0, 100);
-    if (percent == last_percent && stage == last_stage) return true;
+    if (stage == last_stage && percent < last_percent + 5) return true;
     last_percent = percent;
     last_stage = stage;
     text = name.toStdString() + ": " + stage;
