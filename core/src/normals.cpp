@@ -4,6 +4,7 @@
 #include "hedge/normals.h"
 
 #include <algorithm>
+#include <cstring>
 
 #include "hedge/error.h"
 
@@ -76,6 +77,18 @@ void vertex_normals(const Mesh& mesh, std::span<Vec3f> out) {
     } while (h != h0);
   }
   for (Vec3f& n : out) n = normalize(n);
+}
+
+void refresh_normal_channels(Mesh& mesh, bool vertices, bool faces) {
+  auto fill = [](ChannelArray* c, const std::vector<Vec3f>& normals) {
+    if (!c || c->scalar() != ScalarType::f32 || c->components() != 3) return;
+    for (std::size_t i = 0; i < normals.size() && i < c->size(); ++i)
+      std::memcpy(c->element(i), &normals[i], sizeof(Vec3f));
+  };
+  if (vertices)
+    if (ChannelArray* c = mesh.vertex_properties().get_channel("normal")) fill(c, vertex_normals(mesh));
+  if (faces)
+    if (ChannelArray* c = mesh.face_properties().get_channel("normal")) fill(c, face_normals(mesh));
 }
 
 }  // namespace hedge

@@ -11,45 +11,12 @@
 
 #include "hedge/error.h"
 #include "hedge/validate.h"
+#include "test_meshes.h"
 
 namespace {
 
 using namespace hedge;
-
-// Builds a manifold mesh with the low-level setters, so these tests depend on nothing but
-// Mesh itself. Corner 0 of a face is the target of halfedge(f).
-Mesh make_mesh(const std::vector<Point>& points, const std::vector<std::vector<Index>>& faces) {
-  Mesh mesh;
-  for (const Point& p : points) mesh.position(mesh.new_vertex()) = p;
-  std::map<std::pair<Index, Index>, Halfedge> between;
-  auto halfedge_from_to = [&](Index a, Index b) {
-    if (auto it = between.find({a, b}); it != between.end()) return it->second;
-    Halfedge h = mesh.new_edge(Vertex(a), Vertex(b));
-    between[{a, b}] = h;
-    between[{b, a}] = opposite(h);
-    return h;
-  };
-  for (const auto& corners : faces) {
-    const Face f = mesh.new_face();
-    const std::size_t n = corners.size();
-    std::vector<Halfedge> loop;  // loop[i] points to corners[i]
-    for (std::size_t i = 0; i < n; ++i) loop.push_back(halfedge_from_to(corners[(i + n - 1) % n], corners[i]));
-    for (std::size_t i = 0; i < n; ++i) {
-      mesh.set_face(loop[i], f);
-      mesh.set_next(loop[i], loop[(i + 1) % n]);
-      mesh.set_halfedge(Vertex(corners[i]), loop[(i + 1) % n]);
-    }
-    mesh.set_halfedge(f, loop[0]);
-  }
-  std::map<Index, Halfedge> boundary_out;
-  for (Index i = 0; i < mesh.halfedges_size(); ++i)
-    if (mesh.is_boundary(Halfedge(i))) boundary_out[mesh.from_vertex(Halfedge(i)).idx()] = Halfedge(i);
-  for (auto [v, h] : boundary_out) {
-    mesh.set_next(h, boundary_out.at(mesh.to_vertex(h).idx()));
-    mesh.set_halfedge(Vertex(v), h);
-  }
-  return mesh;
-}
+using test::make_mesh;
 
 void expect_near(const Vec3f& a, const Vec3f& b, float tolerance = 1e-6f) {
   for (int i = 0; i < 3; ++i) EXPECT_NEAR(a[i], b[i], tolerance) << "component " << i;

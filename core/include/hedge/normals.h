@@ -31,4 +31,9 @@ std::vector<Vec3f> vertex_normals(const Mesh& mesh);
 //! vertices_size(), throws Error otherwise.
 void vertex_normals(const Mesh& mesh, std::span<Vec3f> out);
 
+//! After positions changed: recomputes the hosts' "normal" channels (float x3) of vertices
+//! and/or faces from the new shape, so hosts do not show stale shading. Channels of another
+//! type are left alone.
+void refresh_normal_channels(Mesh& mesh, bool vertices, bool faces);
+
 }  // namespace hedge

@@ -105,20 +105,6 @@ bool is_interior_triangle_edge(const Mesh& m, Edge e) {
   return !m.is_boundary(e) && is_triangle(m, Mesh::halfedge(e, 0)) && is_triangle(m, Mesh::halfedge(e, 1));
 }
 
-//! Positions changed: the "normal" channels (float x3) of vertices and faces are recomputed
-//! from the new shape, so hosts do not show stale shading.
-void refresh_normal_channels(Mesh& mesh, bool vertices, bool faces) {
-  auto fill = [](ChannelArray* c, const std::vector<Vec3f>& normals) {
-    if (!c || c->scalar() != ScalarType::f32 || c->components() != 3) return;
-    for (std::size_t i = 0; i < normals.size() && i < c->size(); ++i)
-      std::memcpy(c->element(i), &normals[i], sizeof(Vec3f));
-  };
-  if (vertices)
-    if (ChannelArray* c = mesh.vertex_properties().get_channel("normal")) fill(c, vertex_normals(mesh));
-  if (faces)
-    if (ChannelArray* c = mesh.face_properties().get_channel("normal")) fill(c, face_normals(mesh));
-}
-
 }  // namespace
 
 double opposite_angle_sum(const Mesh& mesh, Edge e) {

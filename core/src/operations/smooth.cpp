@@ -12,39 +12,13 @@
 
 #include "hedge/error.h"
 #include "hedge/normals.h"
+#include "parallel.h"
 
 namespace hedge {
 namespace {
 
-//! Runs fn(begin, end) over [0, n) split across up to `threads` threads; small ranges stay on
-//! the calling thread.
-template <class Fn>
-void parallel_for(std::size_t n, unsigned threads, Fn&& fn) {
-  constexpr std::size_t kGrain = 16384;
-  std::size_t t = std::min<std::size_t>(std::max(threads, 1u), std::max<std::size_t>(1, n / kGrain));
-  if (t <= 1) {
-    fn(std::size_t(0), n);
-    return;
-  }
-  std::vector<std::thread> pool;
-  std::vector<std::exception_ptr> errors(t);
-  for (std::size_t k = 1; k < t; ++k)
-    pool.emplace_back([&, k] {
-      try {
-        fn(n * k / t, n * (k + 1) / t);
-      } catch (...) {
-        errors[k] = std::current_exception();
-      }
-    });
-  try {
-    fn(std::size_t(0), n / t);
-  } catch (...) {
-    errors[0] = std::current_exception();
-  }
-  for (auto& th : pool) th.join();
-  for (auto& e : errors)
-    if (e) std::rethrow_exception(e);
-}
+// Smoothing steps are short per element: threads pay off from smaller ranges than elsewhere.
+constexpr std::size_t kSmoothGrain = 16384;
 
 //! The neighbours each vertex is smoothed toward, with the edge that joins them (for the
 //! cotangent weights). Fixed vertices have none.
@@ -115,21 +89,7 @@ void cotangent_weights(const Mesh& m, const std::vector<Vec3d>& p, const std::ve
       }
       weight[e] = std::max(0.0, w);
     }
-  });
-}
-
-//! Positions changed: the "normal" channels (float x3) of vertices and faces are recomputed
-//! from the new shape, so hosts do not show stale shading.
-void refresh_normal_channels(Mesh& mesh, bool vertices, bool faces) {
-  auto fill = [](ChannelArray* c, const std::vector<Vec3f>& normals) {
-    if (!c || c->scalar() != ScalarType::f32 || c->components() != 3) return;
-    for (std::size_t i = 0; i < normals.size() && i < c->size(); ++i)
-      std::memcpy(c->element(i), &normals[i], sizeof(Vec3f));
-  };
-  if (vertices)
-    if (ChannelArray* c = mesh.vertex_properties().get_channel("normal")) fill(c, vertex_normals(mesh));
-  if (faces)
-    if (ChannelArray* c = mesh.face_properties().get_channel("normal")) fill(c, face_normals(mesh));
+  }, kSmoothGrain);
 }
 
 }  // namespace
@@ -220,7 +180,7 @@ SmoothReport smooth(Mesh& mesh, const SmoothOptions& options, Progress& progress
         }
         next[v] = current[v] + (sum / total - current[v]) * amount;
       }
-    });
+    }, kSmoothGrain);
     current.swap(next);
   };
 

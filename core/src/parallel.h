@@ -1,0 +1,42 @@
+// parallel_for: the one way the core splits independent work across threads (private header).
+#pragma once
+
+#include <algorithm>
+#include <cstddef>
+#include <exception>
+#include <thread>
+#include <vector>
+
+namespace hedge {
+
+//! Runs fn(begin, end) over [0, n) split across up to `threads` threads; ranges below `grain`
+//! elements per thread stay on the calling thread, where a thread would cost more than it
+//! saves. The first exception thrown by any part is rethrown after all parts have finished.
+template <class Fn>
+void parallel_for(std::size_t n, unsigned threads, Fn&& fn, std::size_t grain = 32768) {
+  std::size_t t = std::min<std::size_t>(std::max(threads, 1u), std::max<std::size_t>(1, n / grain));
+  if (t <= 1) {
+    fn(std::size_t(0), n);
+    return;
+  }
+  std::vector<std::thread> pool;
+  std::vector<std::exception_ptr> errors(t);
+  for (std::size_t k = 1; k < t; ++k)
+    pool.emplace_back([&, k] {
+      try {
+        fn(n * k / t, n * (k + 1) / t);
+      } catch (...) {
+        errors[k] = std::current_exception();
+      }
+    });
+  try {
+    fn(std::size_t(0), n / t);
+  } catch (...) {
+    errors[0] = std::current_exception();
+  }
+  for (auto& th : pool) th.join();
+  for (auto& e : errors)
+    if (e) std::rethrow_exception(e);
+}
+
+}  // namespace hedge

@@ -1,0 +1,48 @@
+// Small meshes for unit tests, made with the low-level setters so that tests of one part
+// depend on nothing but the Mesh class itself.
+#pragma once
+
+#include <map>
+#include <utility>
+#include <vector>
+
+#include "hedge/mesh.h"
+
+namespace hedge::test {
+
+//! A manifold mesh from points and counter-clockwise faces; corner 0 of a face is the target
+//! of halfedge(f), and boundary loops are linked. The faces must form a manifold surface.
+inline Mesh make_mesh(const std::vector<Point>& points, const std::vector<std::vector<Index>>& faces) {
+  Mesh mesh;
+  for (const Point& p : points) mesh.position(mesh.new_vertex()) = p;
+  std::map<std::pair<Index, Index>, Halfedge> between;
+  auto halfedge_from_to = [&](Index a, Index b) {
+    if (auto it = between.find({a, b}); it != between.end()) return it->second;
+    Halfedge h = mesh.new_edge(Vertex(a), Vertex(b));
+    between[{a, b}] = h;
+    between[{b, a}] = opposite(h);
+    return h;
+  };
+  for (const auto& corners : faces) {
+    const Face f = mesh.new_face();
+    const std::size_t n = corners.size();
+    std::vector<Halfedge> loop;  // loop[i] points to corners[i]
+    for (std::size_t i = 0; i < n; ++i) loop.push_back(halfedge_from_to(corners[(i + n - 1) % n], corners[i]));
+    for (std::size_t i = 0; i < n; ++i) {
+      mesh.set_face(loop[i], f);
+      mesh.set_next(loop[i], loop[(i + 1) % n]);
+      mesh.set_halfedge(Vertex(corners[i]), loop[(i + 1) % n]);
+    }
+    mesh.set_halfedge(f, loop[0]);
+  }
+  std::map<Index, Halfedge> boundary_out;
+  for (Index i = 0; i < mesh.halfedges_size(); ++i)
+    if (mesh.is_boundary(Halfedge(i))) boundary_out[mesh.from_vertex(Halfedge(i)).idx()] = Halfedge(i);
+  for (auto [v, h] : boundary_out) {
+    mesh.set_next(h, boundary_out.at(mesh.to_vertex(h).idx()));
+    mesh.set_halfedge(Vertex(v), h);
+  }
+  return mesh;
+}
+
+}  // namespace hedge::test
