@@ -14,6 +14,7 @@ from .native import native, Error, Cancelled, require_native
 # the parameters of each operation's last run (after Blender's property limits).
 last_reports = {}
 last_params = {}
+last_errors = {}  # operation id -> the message of its last failure or cancellation
 
 
 def catalogue():

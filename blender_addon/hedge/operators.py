@@ -11,6 +11,13 @@ INT_LIMIT = 2**31 - 1
 FLOAT_LIMIT = 3.0e38
 # Operation ids of the interactive runs in progress (for tests and scripts that wait).
 running = set()
+# Jobs cancelled by Esc: control returns to the user at once, and the worker thread stops at
+# the operation's next progress checkpoint; kept here until then.
+abandoned = []
+
+
+def reap_abandoned():
+    abandoned[:] = [job for job in abandoned if not job.done()]
 
 # What the Blender exchange does not carry, said in every tooltip of a changing operation.
 NOT_CARRIED = ("Not carried when the connectivity changes: vertex groups, shape keys, custom split "
@@ -66,7 +73,11 @@ class HedgeOperator:
         return {'FINISHED'}
 
     def fail(self, error):
-        self.report({'ERROR'}, f"Hedge {self.operation['title']}: {error}")
+        api.last_errors[self.operation["id"]] = str(error)
+        if isinstance(error, Cancelled):
+            self.report({'WARNING'}, f"Hedge {self.operation['title']}: cancelled; the mesh is unchanged")
+        else:
+            self.report({'ERROR'}, f"Hedge {self.operation['title']}: {error}")
         return {'CANCELLED'}
 
     def execute(self, context):
@@ -122,8 +133,13 @@ class HedgeOperator:
             context.workspace.status_text_set(None)
 
     def modal(self, context, event):
-        if event.type == 'ESC' and self._job is not None:
+        reap_abandoned()
+        if event.type == 'ESC' and event.value == 'PRESS' and self._job is not None:
             self._job.cancel()
+            abandoned.append(self._job)
+            self._stop(context)
+            self._release()
+            return self.fail(Cancelled("cancelled by the user"))
         if event.type != 'TIMER':
             return {'RUNNING_MODAL'}
         n = len(self._targets)

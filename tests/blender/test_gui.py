@@ -83,12 +83,15 @@ def steps():
     bpy.ops.mesh.primitive_monkey_add(location=(0, 0, 0))
     obj = bpy.context.active_object
     bpy.data.objects["Cube"].hide_set(True)
+    with bpy.context.temp_override(window=win, area=area):
+        bpy.ops.ed.undo_push(message="Suzanne")  # what a user's own edit would leave
     yield 1.0
     ui = region(area, 'UI')
     log(f"sidebar region x={ui.x} y={ui.y} {ui.width}x{ui.height}")
     # The tab strip is the right edge of the sidebar; walk it from the top.
     found = False
     x = ui.x + ui.width - 10
+    started = time.monotonic()
     for y in range(ui.y + ui.height - 15, ui.y + 20, -12):
         before = drawn["time"]
         click(win, x, y)
@@ -96,7 +99,7 @@ def steps():
         area.tag_redraw()
         yield 0.3
         if drawn["time"] > before:
-            log(f"Hedge tab found at ({x}, {y})")
+            log(f"Hedge tab found at ({x}, {y}) in {time.monotonic() - started:.1f} s")
             found = True
             break
     if not found:
@@ -121,20 +124,44 @@ def steps():
     area.tag_redraw()
     yield 1.0
     screenshot("gui_after_subdivide.png")
+    # Undo and redo in the real window: the modal run pushed one undo step.
+    name = obj.name
+    with bpy.context.temp_override(window=win, area=area):
+        bpy.ops.ed.undo()
+    yield 0.5
+    obj = bpy.data.objects[name]
+    log(f"after undo: {len(obj.data.polygons)} faces")
+    assert len(obj.data.polygons) == faces, "undo did not restore the mesh"
+    with bpy.context.temp_override(window=win, area=area):
+        bpy.ops.ed.redo()
+    yield 0.5
+    obj = bpy.data.objects[name]
+    log(f"after redo: {len(obj.data.polygons)} faces")
+    assert len(obj.data.polygons) > faces, "redo did not bring the result back"
 
     # Esc cancels a long run and leaves the mesh as it was.
     co_before = np.empty(len(obj.data.vertices) * 3, np.float32)
     obj.data.vertices.foreach_get("co", co_before)
     n_before = len(obj.data.polygons)
     with bpy.context.temp_override(window=win, area=area, region=region(area, 'WINDOW')):
-        bpy.ops.mesh.hedge_remesh('INVOKE_DEFAULT', target_edge_length=0.002, iterations=50)
+        bpy.ops.mesh.hedge_remesh('INVOKE_DEFAULT', target_edge_length=0.01, iterations=100)
     yield 1.0
+    assert "remesh" in operators.running, "the remesh finished before Esc"
+    pressed = time.monotonic()
     win.event_simulate(type='ESC', value='PRESS', x=area.x + 100, y=area.y + 100)
     win.event_simulate(type='ESC', value='RELEASE', x=area.x + 100, y=area.y + 100)
     for _ in range(300):
         yield 0.2
         if not operators.running:
             break
+    log(f"Esc returned control in {time.monotonic() - pressed:.1f} s: {hedge.api.last_errors.get('remesh')}")
+    for _ in range(300):
+        if not operators.abandoned:
+            break
+        operators.reap_abandoned()
+        yield 0.2
+    log(f"the worker stopped {time.monotonic() - pressed:.1f} s after Esc")
+    assert "cancelled" in hedge.api.last_errors.get("remesh", ""), "the remesh was not cancelled"
     co_after = np.empty(len(obj.data.vertices) * 3, np.float32)
     obj.data.vertices.foreach_get("co", co_after)
     log(f"after Esc: {len(obj.data.polygons)} faces (before {n_before})")
