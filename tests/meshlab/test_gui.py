@@ -1,6 +1,6 @@
 """GUI smoke test under Xvfb: MeshLab starts with the plugin, and its Filters menu holds every
 Hedge filter under the submenu of its class; Hedge: Decimate opens its parameter dialog and
-applies from it. The menus are found and read by OCR (tesseract) on screenshots, so no screen
+applies from it; a refused value brings up MeshLab's failure box with hedge's message. The menus are found and read by OCR (tesseract) on screenshots, so no screen
 coordinate is hard-coded; the screenshots stay in the test's output folder."""
 import os
 import re
@@ -122,6 +122,30 @@ def wait_for(predicate, seconds):
     return False
 
 
+def check_failure_box(screen, checks, dialog, read_log):
+    """A value the catalogue refuses, typed into the still open Decimate dialog: MeshLab's
+    "Filter Failure" box shows hedge's message, and the mesh keeps its 1,838 faces."""
+    label = screen.find(dialog, "Target faces", DIALOG)
+    apply = screen.find(dialog, "Apply", DIALOG)
+    if not checks.check(label is not None and apply is not None, "the dialog's Target faces field is found"):
+        return
+    field = {"x": label["x"] + label["w"] + 90, "y": label["y"], "w": 20, "h": label["h"]}  # the line edit right of it
+    screen.click(field)
+    screen.xdotool("key", "ctrl+a")
+    screen.xdotool("key", "minus", "5")
+    screen.click(apply)
+    # The box (untitled without a window manager) wraps the message after "from 0 to".
+    phrases = ["Failure of filter", "Hedge: Decimate", "decimate: parameter target_faces must be an integer"]
+    _, text = screen.wait_for_text("filter_failure_box", (200, 150, 900, 350), phrases)
+    checks.check(all(normal(p) in text for p in phrases),
+                 "a refused value shows MeshLab's Filter Failure box with hedge's message")
+    checks.check(wait_for(lambda: "Hedge: Decimate failed: decimate: parameter target_faces" in read_log(), 10),
+                 "the failure is in MeshLab's log")
+    screen.xdotool("key", "Return")
+    _, text = screen.wait_for_text("after_failure", (0, 580, 700, 120), ["Faces: 1,838"])
+    checks.check("faces1838" in text, "the failed filter left the mesh as it was (1,838 faces)")
+
+
 def main():
     args = mt.parse_args()
     checks = mt.Checks()
@@ -180,8 +204,9 @@ def main():
                     checks.check(applied, "Apply decimates the bunny to half (MeshLab's log)")
                     _, text = screen.wait_for_text("after_decimate", (0, 580, 700, 120), ["Faces: 1,838"])
                     checks.check("faces1838" in text, "MeshLab shows 1,838 faces")
+                    check_failure_box(screen, checks, dialog, read_log)
         checks.check(gui.poll() is None, "MeshLab is still running")
-    except mt.Failure as e:
+    except (mt.Failure, subprocess.CalledProcessError) as e:
         checks.check(False, str(e))
     finally:
         if gui is not None:
