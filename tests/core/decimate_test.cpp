@@ -8,8 +8,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <ctime>
 #include <cstring>
+#include <ctime>
 #include <filesystem>
 #include <map>
 #include <numbers>
@@ -45,8 +45,8 @@ bool load(const std::string& name, Mesh& mesh) {
 // An icosahedron subdivided `levels` times (each triangle into four), on the unit sphere.
 Soup icosphere(int levels) {
   const double t = (1 + std::sqrt(5.0)) / 2;
-  std::vector<Vec3d> p = {{{-1, t, 0}}, {{1, t, 0}}, {{-1, -t, 0}}, {{1, -t, 0}}, {{0, -1, t}}, {{0, 1, t}},
-                          {{0, -1, -t}}, {{0, 1, -t}}, {{t, 0, -1}}, {{t, 0, 1}}, {{-t, 0, -1}}, {{-t, 0, 1}}};
+  std::vector<Vec3d> p = {{{-1, t, 0}},  {{1, t, 0}},  {{-1, -t, 0}}, {{1, -t, 0}}, {{0, -1, t}},  {{0, 1, t}},
+                          {{0, -1, -t}}, {{0, 1, -t}}, {{t, 0, -1}},  {{t, 0, 1}},  {{-t, 0, -1}}, {{-t, 0, 1}}};
   std::vector<std::array<std::uint32_t, 3>> f = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
                                                  {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
                                                  {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
@@ -191,9 +191,9 @@ TEST(Decimate, HitsTheTargetExactlyOnClosedAndOpenMeshes) {
     std::string name;
     std::size_t target;
   };
-  for (const Case& k : {Case{"bunny.off", 368}, Case{"bunny.off", 1000}, Case{"dragon_res4.ply", 2775},
-                        Case{"dragon_res4.ply", 2776}, Case{"dragon_res3.ply", 11948},
-                        Case{"dragon_res3.ply", 11949}}) {
+  for (const Case& k :
+       {Case{"bunny.off", 368}, Case{"bunny.off", 1000}, Case{"dragon_res4.ply", 2775}, Case{"dragon_res4.ply", 2776},
+        Case{"dragon_res3.ply", 11948}, Case{"dragon_res3.ply", 11949}}) {
     Mesh mesh;
     if (!load(k.name, mesh)) {
       std::printf("  %s not present, skipped\n", k.name.c_str());
@@ -309,8 +309,8 @@ TEST(Decimate, NoFlippedTrianglesAndSmallHausdorff) {
     std::string name;
     double ratio, bound;
   };
-  for (const Case& k : {Case{"bunny.off", 0.1, 0.015}, Case{"bunny.off", 0.25, 0.0075},
-                        Case{"dragon_res3.ply", 0.25, 0.006}}) {
+  for (const Case& k :
+       {Case{"bunny.off", 0.1, 0.015}, Case{"bunny.off", 0.25, 0.0075}, Case{"dragon_res3.ply", 0.25, 0.006}}) {
     Mesh input;
     if (!load(k.name, input)) {
       std::printf("  %s not present, skipped\n", k.name.c_str());
@@ -327,9 +327,8 @@ TEST(Decimate, NoFlippedTrianglesAndSmallHausdorff) {
     std::printf(
         "  %s %g%%: %zu -> %zu faces in %.3f s; Hausdorff %.3g diag (in->out %.3g, out->in %.3g, mean %.3g); "
         "quality min %.3f mean %.3f; min angle %.2f deg\n",
-        k.name.c_str(), 100 * k.ratio, input.n_faces(), mesh.n_faces(), r.seconds, h.max / diag,
-        h.a_to_b.max / diag, h.b_to_a.max / diag, h.a_to_b.mean / diag, st.quality_min, st.quality_mean,
-        st.min_angle_degrees);
+        k.name.c_str(), 100 * k.ratio, input.n_faces(), mesh.n_faces(), r.seconds, h.max / diag, h.a_to_b.max / diag,
+        h.b_to_a.max / diag, h.a_to_b.mean / diag, st.quality_min, st.quality_mean, st.min_angle_degrees);
     EXPECT_LT(h.max, k.bound * diag) << k.name;
     EXPECT_EQ(topology_stats(mesh).genus, topology_stats(input).genus) << k.name;
     EXPECT_EQ(topology_stats(mesh).components, topology_stats(input).components) << k.name;
@@ -502,9 +501,10 @@ TEST(Decimate, KeepsUvSeamsAndInterpolatesUvs) {
         worst_v = std::max(worst_v, std::abs(t[1] - p[2] / 2.0));
       }
     }
-    std::printf("  uv cylinder (preserve_boundary %d): %zu faces, %zu seam edges, %zu off the seam; "
-                "worst |u - angle| %.4f, |v - height| %.4f\n",
-                int(preserve_boundary), mesh.n_faces(), seam_edges, seam_edges_off_the_seam, worst_u, worst_v);
+    std::printf(
+        "  uv cylinder (preserve_boundary %d): %zu faces, %zu seam edges, %zu off the seam; "
+        "worst |u - angle| %.4f, |v - height| %.4f\n",
+        int(preserve_boundary), mesh.n_faces(), seam_edges, seam_edges_off_the_seam, worst_u, worst_v);
     EXPECT_GT(seam_edges, 0u);
     EXPECT_EQ(seam_edges_off_the_seam, 0u);
     EXPECT_LT(worst_u, 0.02);
@@ -555,14 +555,14 @@ TEST(Decimate, RefusesParametersOutOfRange) {
   const Operation& op = find_operation("decimate");
   EXPECT_NO_THROW(resolve_params(op, std::map<std::string, std::string>{}));
   for (auto [id, value] : std::vector<std::pair<std::string, std::string>>{{"target_ratio", "1.5"},
-                                                                          {"target_ratio", "-0.1"},
-                                                                          {"max_error", "2"},
-                                                                          {"max_error", "-1"},
-                                                                          {"min_quality", "1.1"},
-                                                                          {"target_faces", "-1"},
-                                                                          {"target_faces", "2147483648"},
-                                                                          {"prevent_flips", "maybe"},
-                                                                          {"target_face", "10"}}) {
+                                                                           {"target_ratio", "-0.1"},
+                                                                           {"max_error", "2"},
+                                                                           {"max_error", "-1"},
+                                                                           {"min_quality", "1.1"},
+                                                                           {"target_faces", "-1"},
+                                                                           {"target_faces", "2147483648"},
+                                                                           {"prevent_flips", "maybe"},
+                                                                           {"target_face", "10"}}) {
     try {
       resolve_params(op, std::map<std::string, std::string>{{id, value}});
       ADD_FAILURE() << id << "=" << value << " accepted";
@@ -639,10 +639,11 @@ TEST(Decimate, DragonTiming) {
     ho.sample_density = name == "dragon.ply" ? 1.0 : 4.0;
     const HausdorffResult h = hausdorff(input, mesh, ho);
     const std::size_t flips = flipped_faces(input, mesh, true);
-    std::printf("  %s: %zu -> %zu faces in %.3f s (CPU %.3f s; load+build %.2f s); Hausdorff %.3g diag (in->out %.3g, "
-                "out->in %.3g, mean %.3g), measured in %.1f s; %zu collapses; %zu interior triangles flipped\n",
-                name.c_str(), input.n_faces(), mesh.n_faces(), r.seconds, r.cpu_seconds, load_s, h.max / diag, h.a_to_b.max / diag,
-                h.b_to_a.max / diag, h.a_to_b.mean / diag, seconds_since(t1), r.report.collapses, flips);
+    std::printf(
+        "  %s: %zu -> %zu faces in %.3f s (CPU %.3f s; load+build %.2f s); Hausdorff %.3g diag (in->out %.3g, "
+        "out->in %.3g, mean %.3g), measured in %.1f s; %zu collapses; %zu interior triangles flipped\n",
+        name.c_str(), input.n_faces(), mesh.n_faces(), r.seconds, r.cpu_seconds, load_s, h.max / diag,
+        h.a_to_b.max / diag, h.b_to_a.max / diag, h.a_to_b.mean / diag, seconds_since(t1), r.report.collapses, flips);
     EXPECT_LT(h.max, 0.005 * diag);
     if (name == "dragon.ply") {
       EXPECT_LT(h.max, 0.0006 * diag);  // the reference, CGAL's Garland-Heckbert, gives 0.00049-0.00056

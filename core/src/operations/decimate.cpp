@@ -16,6 +16,7 @@
 #include "hedge/report.h"
 #ifdef HEDGE_DECIMATE_DEBUG
 #include <cstdio>
+
 #include "hedge/validate.h"
 #endif
 
@@ -166,8 +167,7 @@ class EdgeQueue {
   std::size_t size_ = 0;
 };
 
-
-// The best collapse of one edge, as last evaluated.
+// The best collapse of one edge.
 struct Candidate {
   Point position;     // where the kept vertex goes
   float cost;         // quadric error there (area x squared distance, in units of the diagonal)
@@ -175,7 +175,7 @@ struct Candidate {
   std::uint8_t side;  // collapse halfedge(e, side): its from_vertex goes
 };
 
-// Per-vertex flags, kept in one byte array next to the quadrics. The seam bits say what a
+// Per-vertex flags, kept with the quadric (VertexData). The seam bits say what a
 // vertex may do with respect to seams of per-corner attributes: kOnSeam when a seam edge
 // touches it, kSeamLine when it lies inside one seam (it may slide along it), kLockedSeam
 // for seam ends, junctions and seams meeting the boundary (it stays).
@@ -231,7 +231,24 @@ class Decimator {
   }
 
   // ---- collapsing ----------------------------------------------------------------------
-  bool is_legal(Halfedge h, const Point& target) const;
+  // Why a collapse is refused, in the order tested.
+  enum Refusal {
+    kLegal = 0,
+    kEarLeft,      // the triangle on the left has its two other edges on the boundary
+    kValenceLeft,  // vl would be left with two edges
+    kEarRight,
+    kValenceRight,
+    kTriangleHole,  // a hole of three edges would become a 2-gon
+    kSharedCorner,  // both triangles have the same third corner
+    kPinch,         // an interior edge between two boundary vertices
+    kLowValence,    // the merged vertex would have fewer than three edges
+    kDoubleEdge,    // v0 and v1 are joined twice
+    kLink,          // the rings share a vertex besides vl and vr
+    kFold,          // a triangle would turn too far or become degenerate
+    kQuality,       // the worst triangle would fall below min_quality
+    kRefusals
+  };
+  Refusal check(Halfedge h, const Point& target) const;
   bool triangle_ok(const Vec3d& old_apex, const Vec3d& new_apex, const Vec3d& a, const Vec3d& b) const;
   bool collapse(Halfedge h, const Candidate& c);
   // Barycentric coordinates of a point in a triangle, by its corner half-edges.
@@ -272,8 +289,7 @@ class Decimator {
     Face face;      // the face between it and the next neighbour (invalid: a hole)
     Vec3d position;
   };
-  mutable std::vector<RingEntry> ring0_, ring1_;  // scratch of is_legal()
-  mutable int refusal_ = 0;  // which test refused the last collapse (for debugging)
+  mutable std::vector<RingEntry> ring0_, ring1_;  // scratch of check()
   mutable double worst_new_ = 1, worst_old_ = 1;  // triangle quality around the collapse being tested
 
   std::vector<ChannelArray*> corner_channels_;  // host per-corner channels (seams are judged on these)
@@ -291,8 +307,8 @@ class Decimator {
   int vertex_blend_size_ = 0;
 
   // Scratch of one collapse (reused: no allocation per collapse).
-  std::vector<Face> wedge_faces_[2];       // faces whose corner at the kept vertex joins wedge l / r
-  std::vector<std::byte> wedge_values_;    // corner values: [l removed, l kept, r removed, r kept] per channel
+  std::vector<Face> wedge_faces_[2];     // faces whose corner at the kept vertex joins wedge l / r
+  std::vector<std::byte> wedge_values_;  // new corner values: [wedge l, wedge r] per channel
   bool wedge_present_[2] = {false, false};
   Index interp_index_[2];
   float interp_weight_[2];
@@ -571,8 +587,8 @@ bool Decimator::triangle_ok(const Vec3d& old_apex, const Vec3d& new_apex, const 
 
 // The link condition (Dey et al.), pmp's and OpenMesh's guards against pinching and
 // pillows, and the geometric checks on every triangle that survives around both ends.
-// Stricter than Mesh::is_collapse_ok(), in O(valence) with marks instead of searches.
-bool Decimator::is_legal(Halfedge h, const Point& target) const {
+// Stricter than Mesh::is_collapse_ok(), in O(valence).
+Decimator::Refusal Decimator::check(Halfedge h, const Point& target) const {
   const Halfedge o = Mesh::opposite(h);
   const Vertex v0 = m_.to_vertex(o), v1 = m_.to_vertex(h);
   const Face fl = m_.face(h), fr = m_.face(o);
@@ -580,25 +596,25 @@ bool Decimator::is_legal(Halfedge h, const Point& target) const {
   if (fl.is_valid()) {
     const Halfedge hn = m_.next(h), hp = m_.prev(h);
     vl = m_.to_vertex(hn);
-    if (m_.is_boundary(Mesh::opposite(hn)) && m_.is_boundary(Mesh::opposite(hp))) { refusal_ = 1; return false; }
-    if (vd_[vl.idx()].valence <= 3 && !(vd_[vl.idx()].flags & kBoundary)) { refusal_ = 2; return false; }
+    if (m_.is_boundary(Mesh::opposite(hn)) && m_.is_boundary(Mesh::opposite(hp))) return kEarLeft;
+    if (vd_[vl.idx()].valence <= 3 && !(vd_[vl.idx()].flags & kBoundary)) return kValenceLeft;
   }
   if (fr.is_valid()) {
     const Halfedge on = m_.next(o), op = m_.prev(o);
     vr = m_.to_vertex(on);
-    if (m_.is_boundary(Mesh::opposite(on)) && m_.is_boundary(Mesh::opposite(op))) { refusal_ = 3; return false; }
-    if (vd_[vr.idx()].valence <= 3 && !(vd_[vr.idx()].flags & kBoundary)) { refusal_ = 4; return false; }
+    if (m_.is_boundary(Mesh::opposite(on)) && m_.is_boundary(Mesh::opposite(op))) return kEarRight;
+    if (vd_[vr.idx()].valence <= 3 && !(vd_[vr.idx()].flags & kBoundary)) return kValenceRight;
   }
   // A hole of three edges would become a 2-gon (possible where build() left a multi-edge).
-  if (!fl.is_valid() && m_.next(m_.next(m_.next(h))) == h) { refusal_ = 5; return false; }
-  if (!fr.is_valid() && m_.next(m_.next(m_.next(o))) == o) { refusal_ = 6; return false; }
+  if (!fl.is_valid() && m_.next(m_.next(m_.next(h))) == h) return kTriangleHole;
+  if (!fr.is_valid() && m_.next(m_.next(m_.next(o))) == o) return kTriangleHole;
   const bool b0 = vd_[v0.idx()].flags & kBoundary, b1 = vd_[v1.idx()].flags & kBoundary;
   if (fl.is_valid() && fr.is_valid()) {
-    if (vl == vr) { refusal_ = 7; return false; }
-    if (b0 && b1) { refusal_ = 8; return false; }
+    if (vl == vr) return kSharedCorner;
+    if (b0 && b1) return kPinch;
   }
   const int removed_faces = int(fl.is_valid()) + int(fr.is_valid());
-  if (!b0 && !b1 && int(vd_[v0.idx()].valence) + int(vd_[v1.idx()].valence) - 2 - removed_faces < 3) { refusal_ = 9; return false; }
+  if (!b0 && !b1 && int(vd_[v0.idx()].valence) + int(vd_[v1.idx()].valence) - 2 - removed_faces < 3) return kLowValence;
 
   // The two rings, in order: each entry is a neighbour and the face between it and the next.
   auto gather = [&](Vertex v, std::vector<RingEntry>& ring) {
@@ -611,11 +627,11 @@ bool Decimator::is_legal(Halfedge h, const Point& target) const {
   // would become a loop. The rings are short, so plain scans beat marking arrays.
   int edges_to_v1 = 0;
   for (const RingEntry& r : ring0_) edges_to_v1 += r.vertex == v1;
-  if (edges_to_v1 > 1) { refusal_ = 10; return false; }
+  if (edges_to_v1 > 1) return kDoubleEdge;
   for (const RingEntry& r1 : ring1_) {
     if (r1.vertex == vl || r1.vertex == vr || r1.vertex == v0) continue;
     for (const RingEntry& r0 : ring0_)
-      if (r0.vertex == r1.vertex) { refusal_ = 12; return false; }
+      if (r0.vertex == r1.vertex) return kLink;
   }
   // Every triangle that stays, around either end, with its apex moved to the target. Quality
   // is judged over the whole neighbourhood (pmp's rule): a collapse may not make its worst
@@ -639,10 +655,10 @@ bool Decimator::is_legal(Halfedge h, const Point& target) const {
     }
     return true;
   };
-  if (!faces_ok(v0, ring0_)) { refusal_ = 11; return false; }
-  if (!faces_ok(v1, ring1_)) { refusal_ = 13; return false; }
-  if (worst_new_ < opt_.min_quality && worst_new_ < worst_old_) { refusal_ = 14; return false; }
-  return true;
+  if (!faces_ok(v0, ring0_)) return kFold;
+  if (!faces_ok(v1, ring1_)) return kFold;
+  if (worst_new_ < opt_.min_quality && worst_new_ < worst_old_) return kQuality;
+  return kLegal;
 }
 
 // Where the new vertex lies in the old surface: the nearest point of the triangles among
@@ -794,7 +810,7 @@ void Decimator::blend_wedges(Vertex kept) {
 }
 
 // Vertex attributes at the new vertex: host channels by barycentric interpolation in the old
-// triangle holding it (among the faces around both ends, gathered by is_legal()), located
+// triangle holding it (among the faces around both ends, gathered by check()), located
 // before the collapse while those triangles exist; internal arrays (build()'s provenance)
 // by the generic interpolation along the edge.
 void Decimator::locate_vertex(const Candidate& c) {
@@ -821,13 +837,13 @@ void Decimator::interpolate_vertex(Vertex removed, Vertex kept, const Candidate&
     if (a.channel && vertex_blend_size_ == 3 && a.channel->stride() <= 256) {
       // Deleted vertices keep their rows until garbage collection: the removed end's too.
       std::byte out[256];
-      const std::byte* src[3] = {a.channel->element(vertex_blend_index_[0]),
-                                 a.channel->element(vertex_blend_index_[1]),
+      const std::byte* src[3] = {a.channel->element(vertex_blend_index_[0]), a.channel->element(vertex_blend_index_[1]),
                                  a.channel->element(vertex_blend_index_[2])};
       blend_element(*a.channel, out, src, vertex_blend_weight_);
       std::memcpy(a.channel->element(kept.idx()), out, a.channel->stride());
     } else {
-      a.array->interpolate(kept.idx(), std::span<const Index>(interp_index_, 2), std::span<const float>(interp_weight_, 2));
+      a.array->interpolate(kept.idx(), std::span<const Index>(interp_index_, 2),
+                           std::span<const float>(interp_weight_, 2));
     }
   }
 }
@@ -849,7 +865,7 @@ bool Decimator::collapse(Halfedge h, const Candidate& c) {
   try {
     m_.collapse(h);
   } catch (const Error&) {
-    // is_legal() is meant to be the stricter test; should the mesh refuse anyway, nothing
+    // check() is meant to be the stricter test; should the mesh refuse anyway, nothing
     // has changed yet (gather_wedges only reads) and the edge is simply skipped.
     return false;
   }
@@ -972,7 +988,7 @@ DecimateReport Decimator::run() {
       if (!has_boundary_) break;
       continue;
     }
-    if (!is_legal(h, c.position) || !collapse(h, c)) continue;
+    if (check(h, c.position) != kLegal || !collapse(h, c)) continue;
     ++report_.collapses;
     ++collapses_since_fill;
     max_error_sq_seen_ = std::max(max_error_sq_seen_, error_sq);
@@ -980,14 +996,22 @@ DecimateReport Decimator::run() {
 
 #ifdef HEDGE_DECIMATE_DEBUG
   {
-    int hist[32] = {0}, no_candidate = 0, ok = 0;
+    int hist[kRefusals] = {0}, no_candidate = 0, ok = 0;
     for (Edge e : m_.edges()) {
       Candidate c;
-      if (!evaluate(e, c)) { ++no_candidate; continue; }
-      if (is_legal(Mesh::halfedge(e, c.side), c.position)) ++ok; else ++hist[refusal_];
+      if (!evaluate(e, c)) {
+        ++no_candidate;
+        continue;
+      }
+      const Refusal why = check(Mesh::halfedge(e, c.side), c.position);
+      if (why == kLegal)
+        ++ok;
+      else
+        ++hist[why];
     }
     std::fprintf(stderr, "end: %d without candidate, %d legal;", no_candidate, ok);
-    for (int i = 0; i < 32; ++i) if (hist[i]) std::fprintf(stderr, " [%d]=%d", i, hist[i]);
+    for (int i = 0; i < kRefusals; ++i)
+      if (hist[i]) std::fprintf(stderr, " [%d]=%d", i, hist[i]);
     std::fprintf(stderr, "\n");
   }
 #endif
@@ -1046,12 +1070,14 @@ Operation decimate_operation() {
   op.help =
       "Reduces the number of triangles while keeping the shape: repeatedly collapses the edge whose removal "
       "changes the surface least, measured by quadric error metrics (Garland and Heckbert, SIGGRAPH 1997), and "
-      "puts the merged vertex where the error is smallest. Use it to make scans and dense meshes light enough to "
-      "display, edit or send. Polygons are triangulated first. Vertex attributes are interpolated; per-corner "
-      "attributes such as UVs are interpolated per wedge and kept continuous across seams (Hoppe 1999). "
-      "Boundaries stay in place by default and no triangle is flipped. It does not keep sharp creases specially "
-      "(the quadrics already favour them), does not weigh attributes in the error, and changes the "
-      "topology never: holes, handles and components stay.";
+      "puts the merged vertex where that error is smallest. Use it to make scans and dense meshes light enough to "
+      "display, edit or send. Polygons are triangulated first. Vertex attributes are interpolated at the new "
+      "vertex; per-corner attributes such as UVs are interpolated per wedge and kept continuous across seams "
+      "(after Hoppe 1999), and vertices on a seam only slide along it. Boundaries stay in place by default, no "
+      "triangle is flipped, and the topology never changes: holes, handles and components stay, so a mesh full "
+      "of small pieces and slits may stop above its target. Attributes do not weigh in the error (a UV seam or "
+      "colour edge is kept by the seam rules, not by the metric), and creases get no special treatment beyond "
+      "what the quadrics give them.";
   op.params = {
       ParamSpec::integer("target_faces", "Target faces", 0, 0, 2147483647,
                          "Number of triangles to reach; 0 uses the target ratio instead. On a closed surface an "
@@ -1067,8 +1093,8 @@ Operation decimate_operation() {
                          "Keep per-corner attributes (UVs, corner normals, colours) continuous: vertices on a seam "
                          "only move along it, seam ends and junctions stay."),
       ParamSpec::boolean("prevent_flips", "Prevent flips", true,
-                         "Refuse collapses that turn a triangle over (normal change above 90 degrees) or make it "
-                         "degenerate."),
+                         "Refuse collapses that turn a triangle over (normal change of 90 degrees or more) or make "
+                         "it degenerate; collapses turning triangles by at most 30 degrees go first."),
       ParamSpec::real("min_quality", "Min triangle quality", 0, 0, 1,
                       "Refuse collapses that create triangles of quality (2 inradius / circumradius, 1 = "
                       "equilateral) below this, unless the triangles they replace were already worse."),
