@@ -46,10 +46,12 @@ class Target:
         me = self.obj.data
         if self.edit:
             # The edit mesh is the truth in Edit Mode: work on a copy, load it back after.
+            self.obj.update_from_editmode()  # the weights are read from the object's mesh
             self.scratch = bpy.data.meshes.new("hedge scratch")
             bmesh.from_edit_mesh(me).to_mesh(self.scratch)
             me = self.scratch
         self.data = exchange.read_mesh(me)
+        exchange.read_vertex_groups(self.obj, self.obj.data, self.data)
         return self.data.soup
 
     def check_writable(self, op):
@@ -63,13 +65,22 @@ class Target:
     def write(self):
         if self.result is not None:
             if self.edit:
-                messages = exchange.write_mesh(self.scratch, self.data, self.result)
+                # A stand-in object lets the vertex groups be rebuilt on the scratch mesh, in
+                # the object's order, before the edit mesh loads it.
+                stand_in = bpy.data.objects.new("hedge scratch", self.scratch)
+                bpy.context.scene.collection.objects.link(stand_in)
+                try:
+                    for name in self.data.vertex_groups:
+                        stand_in.vertex_groups.new(name=name)
+                    messages = exchange.write_mesh(self.scratch, self.data, self.result, obj=stand_in)
+                finally:
+                    bpy.data.objects.remove(stand_in)
                 bm = bmesh.from_edit_mesh(self.obj.data)
                 bm.clear()
                 bm.from_mesh(self.scratch)
                 bmesh.update_edit_mesh(self.obj.data, loop_triangles=True, destructive=True)
             else:
-                messages = exchange.write_mesh(self.obj.data, self.data, self.result)
+                messages = exchange.write_mesh(self.obj.data, self.data, self.result, obj=self.obj)
                 self.obj.data.update()
             if self.report is not None:
                 self.report.setdefault("messages", []).extend(messages)

@@ -12,8 +12,10 @@
 #   selection, hiding            "selected", "hidden"       u8, vertex and face
 #   vertex bevel weight          vertex "bevel_weight"      f32
 #   vertex identity              vertex "blender:vertex"    i32 (where each result vertex came from)
+#   each vertex group            vertex "vgroup:<name>"     f32 weight (0 where not a member)
 # Edge data (seams, sharp edges, creases, bevel weights, generic edge attributes) has no
 # channel: it is matched back by the pair of source vertices of each result edge.
+import bpy
 import numpy as np
 
 # Blender attribute type -> (foreach property, numpy dtype, components)
@@ -65,6 +67,8 @@ class MeshData:
         self.edge_data = {}       # name -> array per edge (flags, crease, bevel weight)
         self.edge_attributes = [] # (name, data_type) generic edge attributes, values in edge_data
         self.not_carried = []     # what could not cross, for the report
+        self.vertex_groups = []   # names, in order, when read (read_vertex_groups)
+        self.active_group = -1
 
 
 def read_mesh(me):
@@ -161,6 +165,81 @@ def read_mesh(me):
         d.not_carried.append("custom split normals")
     d.soup = {"positions": positions, "face_sizes": loop_total, "corners": corners, "channels": channels}
     return d
+
+
+def _socket(sockets, name, kind):
+    return next(s for s in sockets if s.name == name and s.type == kind)
+
+
+def read_vertex_groups(obj, me, data):
+    """Adds each vertex group of `obj` (whose weights live in `me`) as a vertex channel.
+    Blender 3.4 has no bulk access to weights: a temporary geometry-nodes modifier stores
+    each group as a float attribute of the evaluated mesh, read with foreach_get."""
+    names = [g.name for g in obj.vertex_groups]
+    if not names:
+        return
+    tree = bpy.data.node_groups.new("hedge vertex groups", 'GeometryNodeTree')
+    temp = None
+    try:
+        tree.inputs.new('NodeSocketGeometry', "Geometry")
+        tree.outputs.new('NodeSocketGeometry', "Geometry")
+        geometry = tree.nodes.new('NodeGroupInput').outputs[0]
+        for i, name in enumerate(names):
+            read = tree.nodes.new('GeometryNodeInputNamedAttribute')
+            read.data_type = 'FLOAT'
+            read.inputs["Name"].default_value = name
+            store = tree.nodes.new('GeometryNodeStoreNamedAttribute')
+            store.data_type = 'FLOAT'
+            store.domain = 'POINT'
+            store.inputs["Name"].default_value = f"hedge_group_{i}"
+            tree.links.new(geometry, store.inputs["Geometry"])
+            tree.links.new(_socket(read.outputs, "Attribute", 'VALUE'), _socket(store.inputs, "Value", 'VALUE'))
+            geometry = store.outputs["Geometry"]
+        tree.links.new(geometry, tree.nodes.new('NodeGroupOutput').inputs[0])
+        temp = bpy.data.objects.new("hedge vertex groups", me)
+        bpy.context.scene.collection.objects.link(temp)
+        temp.modifiers.new("hedge", 'NODES').node_group = tree
+        bpy.context.view_layer.update()
+        evaluated = temp.evaluated_get(bpy.context.evaluated_depsgraph_get())
+        result = evaluated.to_mesh()
+        try:
+            nv = len(data.soup["positions"])
+            if len(result.vertices) != nv:
+                raise RuntimeError("the evaluated mesh has other vertices")
+            for i, name in enumerate(names):
+                weights = _get(result.attributes[f"hedge_group_{i}"].data, "value", nv, np.float32)
+                data.soup["channels"].append(("vgroup:" + name, "vertex", weights))
+        finally:
+            evaluated.to_mesh_clear()
+        data.vertex_groups = names
+        data.active_group = obj.vertex_groups.active_index
+    except (RuntimeError, KeyError, StopIteration) as e:
+        data.not_carried.append(f"vertex groups ({e})")
+    finally:
+        if temp is not None:
+            bpy.data.objects.remove(temp)
+        bpy.data.node_groups.remove(tree)
+
+
+def write_vertex_groups(obj, me, data, result):
+    """Recreates the vertex groups of a rebuilt mesh, in their order, from their channels
+    (float attributes converted by Blender's own operator; weight 0 means not a member)."""
+    if not data.vertex_groups:
+        return
+    for name in data.vertex_groups:
+        if name in obj.vertex_groups:
+            obj.vertex_groups.remove(obj.vertex_groups[name])
+    for name in data.vertex_groups:
+        weights = channel(result, "vgroup:" + name, "vertex")
+        attr = me.attributes.new(name, 'FLOAT', 'POINT')
+        if weights is not None:
+            _set(attr.data, "value", weights)
+        me.attributes.active = attr
+        # edit_object=None: in Edit Mode the stand-in object of the scratch mesh is converted.
+        with bpy.context.temp_override(object=obj, active_object=obj, edit_object=None):
+            bpy.ops.geometry.attribute_convert(mode='VERTEX_GROUP')
+    if 0 <= data.active_group < len(obj.vertex_groups):
+        obj.vertex_groups.active_index = data.active_group
 
 
 def channel(soup, name, domain):
@@ -297,9 +376,10 @@ def repeated_vertex_faces(sizes, corners):
     return int(np.count_nonzero(np.add.reduceat(repeat, starts)))
 
 
-def write_mesh(me, data, result, rebuild=False):
+def write_mesh(me, data, result, rebuild=False, obj=None):
     """Writes a result dict into `me`. Same topology: in place (unless `rebuild`). Otherwise
-    the geometry is rebuilt and every layer recreated from its channel."""
+    the geometry is rebuilt and every layer recreated from its channel; vertex groups too
+    when `obj` (an object using `me`) is given."""
     if not rebuild and same_topology(data.soup, result):
         _write_channels_in_place(me, data, result)
         me.update()
@@ -322,6 +402,8 @@ def write_mesh(me, data, result, rebuild=False):
     me.update(calc_edges=True)
     _write_attributes(me, data, result, create=True)
     _write_edges(me, data, result)
+    if obj is not None:
+        write_vertex_groups(obj, me, data, result)
     messages = []
     bad = repeated_vertex_faces(sizes, corners)
     if bad:

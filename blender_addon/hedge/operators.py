@@ -20,9 +20,10 @@ def reap_abandoned():
     abandoned[:] = [job for job in abandoned if not job.done()]
 
 # What the Blender exchange does not carry, said in every tooltip of a changing operation.
-NOT_CARRIED = ("Not carried when the connectivity changes: vertex groups, shape keys, custom split "
-               "normals, loose edges; edge data (seams, sharp, crease) follows edges whose ends "
-               "both come from the vertices of such an edge")
+NOT_CARRIED = ("Not carried when the connectivity changes: shape keys (such meshes are refused), custom "
+               "split normals, loose edges. Vertex group weights are interpolated (weight 0 leaves "
+               "the group); seams, sharp edges and creases follow edges whose ends both come from "
+               "the vertices of such an edge")
 
 
 def first_paragraph(text):

@@ -38,6 +38,8 @@ def install_addon():
 
 
 def clear_scene():
+    if bpy.context.object is not None and bpy.context.object.mode != 'OBJECT':
+        bpy.ops.object.mode_set(mode='OBJECT')
     bpy.ops.object.select_all(action='SELECT')
     bpy.ops.object.delete()
     for me in list(bpy.data.meshes):

@@ -160,6 +160,30 @@ class PrimitivesTest(unittest.TestCase):
             self.assertTrue(np.array_equal(before[key], after[key]), key)
         self.assertEqual(obj.vertex_groups["left"].weight(150), 0.75)
 
+    def test_vertex_groups_follow(self):
+        obj = add_primitive("monkey")
+        co = mesh_arrays(obj.data)["co"].reshape(-1, 3)
+        left = obj.vertex_groups.new(name="left")
+        left.add([int(i) for i in np.flatnonzero(co[:, 0] > 0.1)], 1.0, 'REPLACE')
+        ramp = obj.vertex_groups.new(name="ramp")
+        ramp.add(list(range(len(co))), 0.5, 'REPLACE')
+        obj.vertex_groups.active_index = 0
+        for mode in ('OBJECT', 'EDIT'):
+            bpy.ops.object.mode_set(mode=mode)
+            bpy.ops.mesh.hedge_subdivide(scheme='catmull_clark')
+            bpy.ops.object.mode_set(mode='OBJECT')
+            me = obj.data
+            self.assertEqual([g.name for g in obj.vertex_groups], ["left", "ramp"], mode)
+            self.assertEqual(obj.vertex_groups.active_index, 0)
+            co = mesh_arrays(me)["co"].reshape(-1, 3)
+            # Every vertex of the ramp group keeps weight 0.5; "left" holds the x > 0.1 side.
+            self.assertAlmostEqual(obj.vertex_groups["ramp"].weight(len(co) - 1), 0.5, places=5)
+            right = int(np.flatnonzero(co[:, 0] > 0.5)[0])
+            self.assertAlmostEqual(obj.vertex_groups["left"].weight(right), 1.0, places=5)
+            far_left = int(np.flatnonzero(co[:, 0] < -0.5)[0])
+            with self.assertRaises(RuntimeError):
+                obj.vertex_groups["left"].weight(far_left)
+
     def test_make_delaunay_and_repair(self):
         obj = add_uv_sphere()
         bpy.ops.mesh.hedge_triangulate()
