@@ -39,6 +39,23 @@ class AddonTest(unittest.TestCase):
                     self.assertEqual(prop.default, p["default"])
                 self.assertIn(p["help"][:20], prop.description)
 
+    def test_panel_and_menus(self):
+        self.assertTrue(hasattr(bpy.types, "VIEW3D_PT_hedge"))
+        self.assertEqual(bpy.types.VIEW3D_PT_hedge.bl_category, "Hedge")
+        self.assertEqual(bpy.types.VIEW3D_PT_hedge.bl_region_type, 'UI')
+        self.assertTrue(hasattr(bpy.types, "VIEW3D_MT_hedge"))
+        for menu in ("VIEW3D_MT_object", "VIEW3D_MT_edit_mesh"):
+            draw_funcs = getattr(bpy.types, menu).draw._draw_funcs
+            self.assertIn(hedge.panel.menu_entry, draw_funcs, menu)
+
+    def test_disable_enable(self):
+        import addon_utils
+        addon_utils.disable("hedge")
+        self.assertNotIn("hedge_decimate", dir(bpy.ops.mesh))
+        self.assertFalse(hasattr(bpy.types, "VIEW3D_PT_hedge"))
+        addon_utils.enable("hedge", default_set=True, handle_error=None)
+        self.assertIn("hedge_decimate", dir(bpy.ops.mesh))
+
     def test_decimate_sphere(self):
         clear_scene()
         obj = add_primitive("uv_sphere", segments=64, ring_count=32)

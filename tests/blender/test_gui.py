@@ -108,6 +108,18 @@ def steps():
     # Move the mouse off the strip so no tooltip covers the panel.
     win.event_simulate(type='MOUSEMOVE', value='NOTHING', x=area.x + area.width // 3, y=area.y + area.height // 2)
     yield 1.0
+    # Mesh Report, interactively: its figures appear in the panel.
+    with bpy.context.temp_override(window=win, area=area, region=region(area, 'WINDOW')):
+        bpy.ops.mesh.hedge_report('INVOKE_DEFAULT')
+    for _ in range(50):
+        yield 0.2
+        if not operators.running:
+            break
+    report = hedge.api.last_reports.get("report:" + obj.name)
+    log(f"Mesh Report: {report and report['faces']} faces, {report and report['boundary_loops']} holes")
+    assert report and report["faces"] == 500, "Mesh Report did not run"
+    area.tag_redraw()
+    yield 1.0
     screenshot("gui_hedge_panel.png")
 
     # An interactive run: the modal operator on a worker thread.
