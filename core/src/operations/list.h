@@ -8,7 +8,7 @@
   X(subdivide)          \
   X(smooth)             \
   X(make_delaunay)      \
+  X(triangulate)        \
   X(remesh)             \
   X(fill_holes)         \
-  X(repair)             \
-  X(triangulate)
+  X(repair)
