@@ -29,7 +29,7 @@ def draw_report(layout, title, report):
     for key, value in report.items():
         if key == "messages":
             continue
-        row = col.row()
+        row = col.split(factor=0.64)
         row.label(text=key.replace("_", " "))
         row.label(text=format_value(value))
     for message in report.get("messages", []):
