@@ -121,6 +121,8 @@ class EdgeQueue {
     return (bits & ~0xffu) | version;
   }
   static std::uint8_t version(std::uint32_t key) { return std::uint8_t(key & 0xffu); }
+  //! The current version of each edge, to drop stale entries early.
+  explicit EdgeQueue(const std::vector<std::uint8_t>* versions) : versions_(versions) {}
   struct Entry {
     std::uint32_t key;
     Index edge;
@@ -141,9 +143,10 @@ class EdgeQueue {
     buckets_[bucket(k)].push_back({k, edge});
     ++size_;
   }
-  //! Takes the entry of least key; precondition: !empty().
+  //! Takes the entry of least key, or an entry with a stale version; precondition: !empty().
   Entry pop() {
     if (buckets_[0].empty()) refill();
+    if (buckets_[0].empty()) return {0, kInvalidIndex};  // only stale entries were left
     const Entry e = buckets_[0].back();
     buckets_[0].pop_back();
     --size_;
@@ -152,16 +155,29 @@ class EdgeQueue {
 
  private:
   int bucket(std::uint32_t k) const { return k == last_ ? 0 : 32 - std::countl_zero(k ^ last_); }
+  // Stale entries are dropped on the way (most entries are: every collapse re-queues the
+  // edges around the kept vertex), so they are not moved down bucket after bucket.
   void refill() {
-    int i = 1;
-    while (buckets_[i].empty()) ++i;
-    std::vector<Entry>& from = buckets_[i];
-    std::uint32_t least = from.front().key;
-    for (const Entry& e : from) least = std::min(least, e.key);
-    last_ = least;
-    for (const Entry& e : from) buckets_[bucket(e.key)].push_back(e);
-    from.clear();
+    for (;;) {
+      int i = 1;
+      while (i < 33 && buckets_[i].empty()) ++i;
+      if (i == 33) return;
+      std::vector<Entry>& from = buckets_[i];
+      std::size_t live = 0;
+      for (const Entry& e : from)
+        if ((*versions_)[e.edge] == version(e.key)) from[live++] = e;
+      size_ -= from.size() - live;
+      from.resize(live);
+      if (live == 0) continue;
+      std::uint32_t least = from.front().key;
+      for (const Entry& e : from) least = std::min(least, e.key);
+      last_ = least;
+      for (const Entry& e : from) buckets_[bucket(e.key)].push_back(e);
+      from.clear();
+      return;
+    }
   }
+  const std::vector<std::uint8_t>* versions_;
   std::vector<Entry> buckets_[33];
   std::uint32_t last_ = 0;
   std::size_t size_ = 0;
@@ -283,7 +299,7 @@ class Decimator {
   };
   std::vector<VertexData> vd_;
   std::vector<std::uint8_t> version_;  // of each edge's current queue entry: one byte, stays in cache
-  EdgeQueue queue_;
+  EdgeQueue queue_{&version_};
   struct RingEntry {
     Vertex vertex;  // a neighbour, in counter-clockwise order
     Face face;      // the face between it and the next neighbour (invalid: a hole)
@@ -965,6 +981,7 @@ DecimateReport Decimator::run() {
       progress_.update(0.1 + 0.85 * double(start_faces - faces_) / double(to_remove), "collapsing edges");
 
     const EdgeQueue::Entry entry = queue_.pop();
+    if (entry.edge == kInvalidIndex) continue;
     const Edge e(entry.edge);
     if (EdgeQueue::version(entry.key) != version_[e.idx()] || m_.is_deleted(e)) continue;
     ++version_[e.idx()];  // out of the queue now
