@@ -81,9 +81,29 @@ def add_attributes(obj):
     me.polygons.foreach_set("material_index", (np.arange(nf) % 2).astype(np.int32))
 
 
+# Operations that need triangles get a triangulated primitive (they refuse polygons, tested
+# in test_bad_input); remesh gets a target that keeps it quick.
+NEEDS_TRIANGLES = {"make_delaunay", "subdivide"}
+PARAMS = {"remesh": {"target_edge_length": 0.15, "iterations": 3}}
+
+
 class PrimitivesTest(unittest.TestCase):
     def setUp(self):
         clear_scene()
+
+    def test_every_operator_on_every_primitive(self):
+        for kind in ("cube", "uv_sphere", "monkey"):
+            for op in hedge.catalogue():
+                clear_scene()
+                obj = add_primitive(kind)
+                if op["id"] in NEEDS_TRIANGLES:
+                    bpy.ops.mesh.hedge_triangulate()
+                result = getattr(bpy.ops.mesh, f"hedge_{op['id']}")(**PARAMS.get(op["id"], {}))
+                self.assertEqual(result, {'FINISHED'}, f"{op['id']} on {kind}")
+                me = obj.data
+                self.assertFalse(me.validate(), f"{op['id']} on {kind} left an invalid mesh")
+                self.assertGreater(len(me.polygons), 0)
+                self.assertIn("UVMap", me.uv_layers, f"{op['id']} on {kind}")
 
     def test_decimate_keeps_uvs_and_attributes(self):
         obj = add_uv_sphere()
