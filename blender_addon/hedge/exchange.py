@@ -325,8 +325,9 @@ def _write_attributes(me, data, result, create, loop_inverse=None):
             ("hidden", "face", me.polygons, "hide", np.bool_),
             ("bevel_weight", "vertex", me.vertices, "bevel_weight", np.float32)):
         values = channel(soup, name, domain)
-        if values is not None:
-            _set(collection, prop, values.view(dtype) if dtype == np.bool_ else values.astype(dtype, copy=False))
+        if values is None or (create and not values.any()):
+            continue  # new geometry starts with zeros and False: nothing to write
+        _set(collection, prop, values.view(dtype) if dtype == np.bool_ else values.astype(dtype, copy=False))
 
 
 def _write_edges(me, data, result):
