@@ -161,7 +161,7 @@ def read_mesh(me):
         d.edge_data["crease"] = _get(me.edges, "crease", ne, np.float32)
     if me.has_bevel_weight_edge:
         d.edge_data["bevel_weight"] = _get(me.edges, "bevel_weight", ne, np.float32)
-    if len(me.vertex_colors) == 0 and me.has_custom_normals:
+    if me.has_custom_normals:
         d.not_carried.append("custom split normals")
     d.soup = {"positions": positions, "face_sizes": loop_total, "corners": corners, "channels": channels}
     return d
@@ -405,7 +405,7 @@ def write_mesh(me, data, result, rebuild=False, obj=None):
     _write_edges(me, data, result)
     if obj is not None:
         write_vertex_groups(obj, me, data, result)
-    messages = []
+    messages = [f"Blender: not carried: {what}" for what in data.not_carried]
     bad = repeated_vertex_faces(sizes, corners)
     if bad:
         # Never leave Blender a face that repeats a vertex; validate() (slow) only then.

@@ -14,8 +14,8 @@
 #include <string>
 #include <thread>
 
-#include "hedge/catalogue.h"
 #include "hedge/build.h"
+#include "hedge/catalogue.h"
 #include "hedge/error.h"
 #include "hedge/io.h"
 
@@ -33,10 +33,18 @@ py::dict param_dict(const ParamSpec& p) {
   d["help"] = p.help;
   d["type"] = param_type_name(p.type);
   switch (p.type) {
-    case ParamType::boolean: d["default"] = p.default_value != 0; break;
-    case ParamType::integer: d["default"] = static_cast<std::int64_t>(p.default_value); break;
-    case ParamType::real: d["default"] = p.default_value; break;
-    case ParamType::choice: d["default"] = p.choices.at(static_cast<std::size_t>(p.default_value)); break;
+    case ParamType::boolean:
+      d["default"] = p.default_value != 0;
+      break;
+    case ParamType::integer:
+      d["default"] = static_cast<std::int64_t>(p.default_value);
+      break;
+    case ParamType::real:
+      d["default"] = p.default_value;
+      break;
+    case ParamType::choice:
+      d["default"] = p.choices.at(static_cast<std::size_t>(p.default_value));
+      break;
   }
   d["min"] = p.min;
   d["max"] = p.max;
@@ -86,16 +94,26 @@ ScalarType scalar_of(const py::dtype& dt) {
 
 py::dtype dtype_of(ScalarType s) {
   switch (s) {
-    case ScalarType::f32: return py::dtype::of<float>();
-    case ScalarType::f64: return py::dtype::of<double>();
-    case ScalarType::i8: return py::dtype::of<std::int8_t>();
-    case ScalarType::u8: return py::dtype::of<std::uint8_t>();
-    case ScalarType::i16: return py::dtype::of<std::int16_t>();
-    case ScalarType::u16: return py::dtype::of<std::uint16_t>();
-    case ScalarType::i32: return py::dtype::of<std::int32_t>();
-    case ScalarType::u32: return py::dtype::of<std::uint32_t>();
-    case ScalarType::i64: return py::dtype::of<std::int64_t>();
-    case ScalarType::u64: return py::dtype::of<std::uint64_t>();
+    case ScalarType::f32:
+      return py::dtype::of<float>();
+    case ScalarType::f64:
+      return py::dtype::of<double>();
+    case ScalarType::i8:
+      return py::dtype::of<std::int8_t>();
+    case ScalarType::u8:
+      return py::dtype::of<std::uint8_t>();
+    case ScalarType::i16:
+      return py::dtype::of<std::int16_t>();
+    case ScalarType::u16:
+      return py::dtype::of<std::uint16_t>();
+    case ScalarType::i32:
+      return py::dtype::of<std::int32_t>();
+    case ScalarType::u32:
+      return py::dtype::of<std::uint32_t>();
+    case ScalarType::i64:
+      return py::dtype::of<std::int64_t>();
+    case ScalarType::u64:
+      return py::dtype::of<std::uint64_t>();
   }
   return py::dtype::of<float>();
 }
@@ -108,9 +126,7 @@ Domain domain_of(const std::string& name) {
 }
 
 // A C-contiguous view of any array-like; the buffer is read in place (one memcpy into the Soup).
-py::array contiguous(const py::handle& obj) {
-  return py::array::ensure(obj, py::array::c_style);
-}
+py::array contiguous(const py::handle& obj) { return py::array::ensure(obj, py::array::c_style); }
 
 Soup soup_from(const py::dict& mesh) {
   Soup soup;
@@ -203,12 +219,18 @@ std::map<std::string, Value> values_from(const Operation& op, const py::dict& pa
   for (const auto& [k, v] : params) {
     const std::string id = py::str(k);
     const ParamSpec* spec = op.find_param(id);
-    if (py::isinstance<py::bool_>(v)) given[id] = v.cast<bool>();
-    else if (py::isinstance<py::int_>(v)) given[id] = v.cast<std::int64_t>();
-    else if (py::isinstance<py::float_>(v)) given[id] = v.cast<double>();
-    else if (py::isinstance<py::str>(v)) given[id] = v.cast<std::string>();
-    else if (spec) throw Error(op.id + ": parameter " + id + " must be " + spec->range_text());
-    else given[id] = std::string(py::str(v));  // resolve_params names the unknown id
+    if (py::isinstance<py::bool_>(v))
+      given[id] = v.cast<bool>();
+    else if (py::isinstance<py::int_>(v))
+      given[id] = v.cast<std::int64_t>();
+    else if (py::isinstance<py::float_>(v))
+      given[id] = v.cast<double>();
+    else if (py::isinstance<py::str>(v))
+      given[id] = v.cast<std::string>();
+    else if (spec)
+      throw Error(op.id + ": parameter " + id + " must be " + spec->range_text());
+    else
+      given[id] = std::string(py::str(v));  // resolve_params names the unknown id
   }
   return given;
 }
