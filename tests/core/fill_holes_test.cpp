@@ -278,9 +278,13 @@ TEST(FillHoles, FairedPatchFollowsAParaboloid) {
 TEST(FillHoles, AttributesAreCarried) {
   Soup soup = grid_with_hole(10, 2.5);
   const std::size_t nv = soup.n_vertices(), nf = soup.n_faces(), nc = soup.n_corners();
-  Channel& quality = soup.add_channel("quality", Domain::vertex, ScalarType::f32, 1);
-  Channel& material = soup.add_channel("material", Domain::face, ScalarType::i32, 1);
-  Channel& uv = soup.add_channel("uv", Domain::corner, ScalarType::f32, 2);
+  // add_channel may move the channels: take references once all are added.
+  soup.add_channel("quality", Domain::vertex, ScalarType::f32, 1);
+  soup.add_channel("material", Domain::face, ScalarType::i32, 1);
+  soup.add_channel("uv", Domain::corner, ScalarType::f32, 2);
+  Channel& quality = *soup.find("quality", Domain::vertex);
+  Channel& material = *soup.find("material", Domain::face);
+  Channel& uv = *soup.find("uv", Domain::corner);
   ASSERT_EQ(quality.count(), nv);
   for (std::size_t v = 0; v < nv; ++v) quality.as<float>()[v] = 1 + soup.positions[v][0];  // 1 .. 11
   for (std::size_t f = 0; f < nf; ++f) material.as<std::int32_t>()[f] = 7;

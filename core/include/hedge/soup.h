@@ -66,6 +66,7 @@ struct Soup {
 
   Channel* find(const std::string& name, Domain domain);
   const Channel* find(const std::string& name, Domain domain) const;
+  //! Adds a zero-filled channel; the reference is valid until the next channel is added.
   Channel& add_channel(std::string name, Domain domain, ScalarType scalar, int components);
 
   //! Throws Error naming the first problem: sizes that do not add up, indices out of

@@ -170,8 +170,8 @@ void refine_vertices(const Mesh& m, Mesh& out, const VertexRule& rule, unsigned 
     }
     return Point{{x, y, z}};
   };
-  for (auto [b, e] : rule.phases)
-    parallel_for(e - b, threads, [&](std::size_t lo, std::size_t hi) {
+  for (const auto& phase : rule.phases)
+    parallel_for(phase.second - phase.first, threads, [&, b = phase.first](std::size_t lo, std::size_t hi) {
       Stencil s;
       for (std::size_t k = b + lo; k < b + hi; ++k) {
         s.clear();
@@ -195,8 +195,8 @@ void refine_vertices(const Mesh& m, Mesh& out, const VertexRule& rule, unsigned 
     props.resize(std::size_t(2) * V + N);
     std::vector<Target> all = targets(props);
     threads = threads_for(all, threads);
-    for (auto [b, e] : rule.phases)
-      parallel_for(e - b, threads, [&](std::size_t lo, std::size_t hi) {
+    for (const auto& phase : rule.phases)
+      parallel_for(phase.second - phase.first, threads, [&, b = phase.first](std::size_t lo, std::size_t hi) {
         Stencil s;
         for (std::size_t k = b + lo; k < b + hi; ++k) {
           s.clear();
