@@ -1117,6 +1117,11 @@ class Builder {
       auto flip = mesh.add_face_property<bool>("hedge:flipped", false);
       for (std::size_t fi = 0; fi < nmf; ++fi) flip.vector()[fi] = flipped_[identity_ ? fi : face_source_[fi]] != 0;
     }
+    if (has_repeats_) {  // these faces come back repeating their vertex (extract)
+      auto repeats = mesh.add_face_property<bool>("hedge:repeats", false);
+      for (std::size_t fi = 0; fi < nmf; ++fi)
+        repeats.vector()[fi] = status_[identity_ ? fi : face_source_[fi]] == kFaceRepeats;
+    }
     if (has_skipped_) {
       auto source = mesh.add_face_property<std::uint32_t>("hedge:source", kInvalidIndex);
       source.vector() = face_source_;
@@ -1183,7 +1188,53 @@ BuildResult build(const Soup& soup, const BuildOptions& options) {
   return Builder(soup, options).run();
 }
 
-Soup extract(const Mesh& mesh, const ExtractOptions& options) {
+namespace {
+
+// An operation can bring two copies of one source vertex into one face (a hole filled
+// across a split non-manifold vertex, a collapse next to a copy); welding them would make
+// the face visit a vertex twice, which no host can hold. Faces whose input did so
+// ("hedge:repeats") weld as they came; in every other face such copies stay separate:
+// in each face, of the corners that weld to one output vertex only one keeps welding (the
+// group's representative `order[out]` when it is there, never a copy already kept apart).
+// Marks only grow and kept-apart copies get their own indices, so one pass settles every
+// face. Returns the copies to keep apart, in mesh order.
+std::vector<std::uint32_t> copies_kept_apart(const Mesh& mesh, const std::vector<std::uint32_t>& vmap,
+                                             const std::vector<std::uint32_t>& order) {
+  std::vector<char> apart(mesh.vertices_size(), 0);
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> corners;  // (output vertex, mesh vertex)
+  const TypedArray<bool>* repeats = mesh.face_properties().get<bool>("hedge:repeats");
+  bool any = false;
+  for (Face f : mesh.faces()) {
+    if (repeats && repeats->vector()[f.idx()]) continue;
+    corners.clear();
+    for (Vertex v : mesh.vertices(f))
+      if (!apart[v.idx()]) corners.emplace_back(vmap[v.idx()], v.idx());
+    std::sort(corners.begin(), corners.end());
+    for (std::size_t i = 0; i < corners.size();) {
+      std::size_t j = i + 1;
+      while (j < corners.size() && corners[j].first == corners[i].first) ++j;
+      if (j - i > 1) {
+        const std::uint32_t representative = order[corners[i].first];
+        std::size_t keep = i;
+        for (std::size_t k = i; k < j; ++k)
+          if (corners[k].second == representative) keep = k;
+        for (std::size_t k = i; k < j; ++k)
+          if (k != keep) apart[corners[k].second] = any = true;
+      }
+      i = j;
+    }
+  }
+  std::vector<std::uint32_t> result;
+  if (any)
+    for (std::uint32_t v = 0; v < apart.size(); ++v)
+      if (apart[v]) result.push_back(v);
+  return result;
+}
+
+}  // namespace
+
+Soup extract(const Mesh& mesh, const ExtractOptions& options, ExtractReport* report) {
+  if (report) *report = {};
   Soup soup;
   const TypedArray<std::uint32_t>* source =
       options.restore_source ? mesh.vertex_properties().get<std::uint32_t>("hedge:source") : nullptr;
@@ -1218,6 +1269,14 @@ Soup extract(const Mesh& mesh, const ExtractOptions& options) {
         vmap[v.idx()] = n_out++;
         order.push_back(v.idx());
       }
+    if (source) {
+      const std::vector<std::uint32_t> apart = copies_kept_apart(mesh, vmap, order);
+      for (std::uint32_t v : apart) {
+        vmap[v] = n_out++;
+        order.push_back(v);
+      }
+      if (report) report->copies_kept_apart = apart.size();
+    }
   }
   const std::size_t n_out_vertices = vertices_identity ? nvs : order.size();
   auto mesh_vertex = [&](std::size_t i) -> std::uint32_t {

@@ -274,7 +274,12 @@ RunResult run_operation(const Operation& op, const Soup& input, const ParamValue
   if (op.changes_mesh) {
     check_valid(built.mesh, op.id);
     progress.update(1.0, "writing the result");
-    result.soup = extract(built.mesh);
+    ExtractReport extracted;
+    result.soup = extract(built.mesh, {}, &extracted);
+    if (extracted.copies_kept_apart)
+      result.report.messages.push_back("kept " + std::to_string(extracted.copies_kept_apart) +
+                                       " copies of non-manifold vertices apart: welding them would have made a "
+                                       "face use one vertex twice");
   }
   double seconds = std::chrono::duration<double>(Clock::now() - start).count();
   result.report.add("seconds", seconds);

@@ -18,6 +18,7 @@
 #include "hedge/error.h"
 #include "hedge/io.h"
 #include "hedge/validate.h"
+#include "test_meshes.h"
 
 namespace hedge {
 namespace {
@@ -286,6 +287,35 @@ TEST(Build, NonManifoldVertexBowtie) {
   EXPECT_EQ(counts(r.report), (Counts{.non_manifold_vertices = 1, .vertex_copies = 1}));
   EXPECT_EQ(boundary_loops(r.mesh), (std::vector<std::size_t>{3, 3}));
   EXPECT_EQ(r.maps.vertex_source.back(), 0u);
+}
+
+TEST(Build, ExtractKeepsCopiesApartThatWouldRepeatAVertex) {
+  // Vertex 0 of the bow-tie becomes 0 (fan 0 1 2) and copy 5 (fan 0 3 4). A face through
+  // both copies, as hole filling or a collapse can make, must not come back as (0, 2, 0, 4).
+  Soup soup = make_soup(5, {{0, 1, 2}, {0, 3, 4}});
+  soup.add_channel("quality", Domain::vertex, ScalarType::f32, 1);
+  BuildResult r = build_and_check(soup);
+  ASSERT_EQ(r.mesh.n_vertices(), 6u);
+  const Vertex copy(5);
+  ASSERT_EQ(r.maps.vertex_source[copy.idx()], 0u);
+  const Vertex corners[] = {Vertex(0), Vertex(2), copy, Vertex(4)};
+  ASSERT_TRUE(r.mesh.add_face(corners).is_valid());
+  ASSERT_VALID(r.mesh);
+
+  ExtractReport report;
+  const Soup out = extract(r.mesh, {}, &report);
+  EXPECT_EQ(report.copies_kept_apart, 1u);
+  ASSERT_EQ(out.positions.size(), 6u);
+  EXPECT_EQ(out.positions[5], out.positions[0]);
+  EXPECT_EQ(out.corners, (std::vector<std::uint32_t>{0, 1, 2, 5, 3, 4, 0, 2, 5, 4}));
+  ASSERT_EQ(out.channels.size(), 1u);
+  EXPECT_EQ(out.channels[0].data.size(), 6 * sizeof(float));
+
+  // Without such a face the copy welds back as before.
+  BuildResult plain = build_and_check(soup);
+  ExtractReport none;
+  EXPECT_EQ(extract(plain.mesh, {}, &none).corners, soup.corners);
+  EXPECT_EQ(none.copies_kept_apart, 0u);
 }
 
 TEST(Build, TwoConesTouchingAtTheirApex) {

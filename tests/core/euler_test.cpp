@@ -17,20 +17,10 @@
 #include "hedge/error.h"
 #include "hedge/mesh.h"
 #include "hedge/validate.h"
+#include "test_meshes.h"
 
 namespace hedge {
 namespace {
-
-#define EXPECT_VALID(mesh)                               \
-  do {                                                   \
-    Validation validation_ = validate(mesh);             \
-    EXPECT_TRUE(validation_) << validation_.message;     \
-  } while (0)
-#define ASSERT_VALID(mesh)                               \
-  do {                                                   \
-    Validation validation_ = validate(mesh);             \
-    ASSERT_TRUE(validation_) << validation_.message;     \
-  } while (0)
 
 Point pt(float x, float y, float z = 0) { return Point{{x, y, z}}; }
 
@@ -1062,6 +1052,16 @@ TEST(Euler, CollapseRefusals) {
     if ((twice.from_vertex(h) == Vertex(0) && twice.to_vertex(h) == Vertex(2)) ||
         (twice.from_vertex(h) == Vertex(2) && twice.to_vertex(h) == Vertex(0)))
       refused(twice, h);
+  // An edge of a hole of three edges (a triangular hole framed by quads): the hole would
+  // become two edges, and the quad beside it a triangle glued to nothing.
+  Mesh frame;
+  for (Point p : {pt(0, 0), pt(4, 0), pt(2, 4), pt(1.5f, 1), pt(2.5f, 1), pt(2, 2)}) frame.add_vertex(p);
+  add_faces(frame, {{0, 1, 4, 3}, {1, 2, 5, 4}, {2, 0, 3, 5}});
+  ASSERT_VALID(frame);
+  for (auto [a, b] : {std::pair{3, 4}, std::pair{4, 5}, std::pair{5, 3}}) {
+    refused(frame, frame.find_halfedge(Vertex(a), Vertex(b)));
+    refused(frame, frame.find_halfedge(Vertex(b), Vertex(a)));
+  }
 }
 
 TEST(Euler, CollapsePolygons) {

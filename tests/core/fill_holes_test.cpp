@@ -21,15 +21,10 @@
 #include "hedge/report.h"
 #include "hedge/topology.h"
 #include "hedge/validate.h"
+#include "test_meshes.h"
 
 namespace hedge {
 namespace {
-
-#define ASSERT_VALID(mesh)            \
-  do {                                \
-    Validation v_ = validate(mesh);   \
-    ASSERT_TRUE(v_.ok) << v_.message; \
-  } while (0)
 
 std::vector<std::size_t> loop_lengths(const Mesh& mesh) {
   std::vector<char> seen(mesh.halfedges_size(), 0);
@@ -507,13 +502,46 @@ TEST(FillHoles, DragonRes4EveryHoleClosed) {
   FillHolesReport r = fill_holes(mesh);
   const double seconds = seconds_since(t0);
   ASSERT_VALID(mesh);
-  EXPECT_EQ(r.holes_found, loops);
-  EXPECT_EQ(r.holes_filled + r.holes_skipped, loops);
-  // What is left open is only what may be: lone faces, two-edge slits.
-  EXPECT_EQ(loop_lengths(mesh).size(), r.holes_skipped);
-  for (std::size_t n : loop_lengths(mesh)) EXPECT_LE(n, 3u);
-  std::printf("[ fill_holes ] dragon_res4: %zu holes, %zu filled, %zu skipped, +%zu vertices +%zu triangles, %.2f s\n",
-              r.holes_found, r.holes_filled, r.holes_skipped, r.vertices_added, r.triangles_added, seconds);
+  // Every edge of dragon_res4 has an even number of faces: its boundary loops are all seams
+  // of split non-manifold edges, and none is a hole.
+  EXPECT_EQ(r.split_seams, loops);
+  EXPECT_EQ(r.holes_found, 0u);
+  EXPECT_EQ(loop_lengths(mesh).size(), loops);
+  EXPECT_EQ(r.triangles_added, 0u);
+  std::printf("[ fill_holes ] dragon_res4: %zu seams of non-manifold edges, %zu holes, %.2f s\n", r.split_seams,
+              r.holes_found, seconds);
+}
+
+TEST(FillHoles, SeamsOfSplitNonManifoldEdgesAreNoHoles) {
+  // Two closed tetrahedra glued along edge 0-1 (four faces on it): building splits the edge,
+  // which leaves boundary loops where the input has none.
+  Soup soup;
+  soup.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {0, -1, 0}, {0, 0, -1}};
+  for (std::uint32_t c : {0, 2, 1, 0, 1, 3, 1, 2, 3, 2, 0, 3, 0, 4, 1, 0, 1, 5, 1, 4, 5, 4, 0, 5})
+    soup.corners.push_back(c);
+  soup.face_sizes.assign(8, 3);
+  Mesh mesh = build(soup).mesh;
+  ASSERT_FALSE(loop_lengths(mesh).empty());
+  FillHolesReport r = fill_holes(mesh);
+  EXPECT_EQ(r.split_seams, loop_lengths(mesh).size());
+  EXPECT_EQ(r.holes_found, 0u);
+  EXPECT_EQ(r.triangles_added, 0u);
+  EXPECT_EQ(extract(mesh).corners, soup.corners);
+
+  // A real hole beside the glued edge is still filled: drop face (1, 4, 5).
+  soup.corners.erase(soup.corners.begin() + 18, soup.corners.begin() + 21);
+  soup.face_sizes.pop_back();
+  mesh = build(soup).mesh;
+  r = fill_holes(mesh);
+  EXPECT_EQ(r.holes_found, 1u);
+  EXPECT_EQ(r.holes_filled, 1u);
+  ASSERT_VALID(mesh);
+  ExtractReport extracted;
+  const Soup out = extract(mesh, {}, &extracted);
+  for (std::size_t f = 0; f < out.n_faces(); ++f) {
+    const std::uint32_t* c = out.corners.data() + 3 * f;
+    EXPECT_TRUE(c[0] != c[1] && c[1] != c[2] && c[0] != c[2]) << "face " << f;
+  }
 }
 
 TEST(FillHoles, DragonRes4AfterRepairOnlyLoneFacesStayOpen) {

@@ -13,15 +13,11 @@
 #include "hedge/io.h"
 #include "hedge/report.h"
 #include "hedge/validate.h"
+#include "test_meshes.h"
+#include "test_meshes.h"
 
 namespace hedge {
 namespace {
-
-#define ASSERT_VALID(mesh)            \
-  do {                                \
-    Validation v_ = validate(mesh);   \
-    ASSERT_TRUE(v_.ok) << v_.message; \
-  } while (0)
 
 // Adds points shifted by x0 along x and returns the index of the first.
 std::uint32_t add_points(Soup& s, float x0, std::initializer_list<std::array<float, 3>> points) {

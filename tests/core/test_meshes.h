@@ -2,11 +2,26 @@
 // depend on nothing but the Mesh class itself.
 #pragma once
 
+#include <gtest/gtest.h>
+
 #include <map>
 #include <utility>
 #include <vector>
 
 #include "hedge/mesh.h"
+#include "hedge/validate.h"
+
+//! Fails the test (ASSERT) or records a failure (EXPECT) naming the broken invariant.
+#define ASSERT_VALID(mesh)                                  \
+  do {                                                      \
+    const ::hedge::Validation validation_ = validate(mesh); \
+    ASSERT_TRUE(validation_.ok) << validation_.message;     \
+  } while (0)
+#define EXPECT_VALID(mesh)                                  \
+  do {                                                      \
+    const ::hedge::Validation validation_ = validate(mesh); \
+    EXPECT_TRUE(validation_.ok) << validation_.message;     \
+  } while (0)
 
 namespace hedge::test {
 

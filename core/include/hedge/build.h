@@ -59,10 +59,17 @@ struct ExtractOptions {
   bool restore_source = true;
 };
 
+struct ExtractReport {
+  //! Vertex copies not welded back because an operation brought two copies of one source
+  //! vertex into one face; they come after every other vertex, in mesh order.
+  std::size_t copies_kept_apart = 0;
+};
+
 //! Mesh -> Soup. After build() with no change in between, gives back the identical soup
 //! (order, values, bit for bit), except faces that build() skipped. Channels come out
 //! grouped by domain (vertex, then face, then corner), each group in the soup's order, so
-//! a soup that lists its channels that way round-trips exactly.
-Soup extract(const Mesh& mesh, const ExtractOptions& options = {});
+//! a soup that lists its channels that way round-trips exactly. No output face visits a
+//! vertex twice: copies that would weld into one within a face stay apart (ExtractReport).
+Soup extract(const Mesh& mesh, const ExtractOptions& options = {}, ExtractReport* report = nullptr);
 
 }  // namespace hedge

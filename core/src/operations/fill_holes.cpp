@@ -700,6 +700,35 @@ FillHolesReport fill_holes(Mesh& input, const FillHolesOptions& options, Progres
       holes.push_back({h, edges});
     }
   }
+  // Loops along edges that build() split apart (non-manifold input) are no holes: in the
+  // input the surface goes on across every one of their edges. Welded through the vertices'
+  // sources, each such edge is shared by two or more faces; a real hole's edges by one.
+  if (const auto* source = input.vertex_properties().get<std::uint32_t>("hedge:source")) {
+    const std::uint64_t n = input.vertices_size();
+    auto welded = [&](Vertex v) -> std::uint64_t {
+      const std::uint32_t s = source->vector()[v.idx()];
+      return s != std::uint32_t(-1) ? s : n + v.idx();  // vertices made by an operation have none
+    };
+    auto key = [&](Halfedge h) {
+      std::uint64_t a = welded(input.from_vertex(h)), b = welded(input.to_vertex(h));
+      if (a > b) std::swap(a, b);
+      return a * 2 * n + b;  // a, b < 2n
+    };
+    std::vector<std::uint64_t> face_sides;  // one key per face side of every edge
+    for (Halfedge h : input.halfedges())
+      if (!input.is_boundary(h)) face_sides.push_back(key(h));
+    std::sort(face_sides.begin(), face_sides.end());
+    auto shared = [&](Halfedge b) {
+      auto [lo, hi] = std::equal_range(face_sides.begin(), face_sides.end(), key(b));
+      return hi - lo >= 2;
+    };
+    std::erase_if(holes, [&](const Hole& hole) {
+      for (Halfedge b : input.loop(hole.start))
+        if (!shared(b)) return false;
+      ++report.split_seams;
+      return true;
+    });
+  }
   report.holes_found = holes.size();
 
   std::vector<Hole> to_fill;
@@ -734,6 +763,10 @@ FillHolesReport fill_holes(Mesh& input, const FillHolesOptions& options, Progres
   if (report.lone_faces)
     report.messages.push_back(std::to_string(report.lone_faces) +
                               " single faces with no neighbour left open (filling would only double them)");
+  if (report.split_seams)
+    report.messages.push_back(std::to_string(report.split_seams) +
+                              " boundary loops along non-manifold edges left open (the input's surface is "
+                              "closed there; building split the edges to work on them)");
   if (report.slits)
     report.messages.push_back(std::to_string(report.slits) +
                               " holes of two edges left open (no triangle fits them; repair removes them)");
@@ -802,6 +835,7 @@ Operation fill_holes_operation() {
     report.add("holes_too_large", count(r.holes_too_large));
     report.add("lone_faces_left_open", count(r.lone_faces));
     report.add("two_edge_slits_left_open", count(r.slits));
+    report.add("non_manifold_seams_left_open", count(r.split_seams));
     report.add("triangles_added", count(r.triangles_added));
     report.add("vertices_added", count(r.vertices_added));
     report.messages = r.messages;
