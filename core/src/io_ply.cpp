@@ -388,25 +388,9 @@ class BinarySource {
         place_(place) {}
 
   double number(PlyType t) {
-    switch (t) {
-      case PlyType::i8:
-        return get<std::int8_t>();
-      case PlyType::u8:
-        return get<std::uint8_t>();
-      case PlyType::i16:
-        return get<std::int16_t>();
-      case PlyType::u16:
-        return get<std::uint16_t>();
-      case PlyType::i32:
-        return get<std::int32_t>();
-      case PlyType::u32:
-        return get<std::uint32_t>();
-      case PlyType::f32:
-        return get<float>();
-      case PlyType::f64:
-        return get<double>();
-    }
-    return 0;
+    if (t == PlyType::f32) return get<float>();
+    if (t == PlyType::f64) return get<double>();
+    return static_cast<double>(integer(t));  // every integer type
   }
 
   std::uint64_t count(PlyType t) {
