@@ -1,6 +1,7 @@
 // Topology counts by one pass over the elements and a union-find over vertices.
 #include "hedge/topology.h"
 
+#include <algorithm>
 #include <numeric>
 #include <vector>
 
@@ -81,6 +82,32 @@ std::size_t face_components(const Mesh& mesh, std::vector<Index>& component_of_f
     ++next_id;
   }
   return next_id;
+}
+
+std::vector<bool> split_seam_edges(const Mesh& mesh) {
+  const auto* source = mesh.vertex_properties().get<std::uint32_t>("hedge:source");
+  if (!source) return {};
+  const std::uint64_t n = mesh.vertices_size();
+  auto welded = [&](Vertex v) -> std::uint64_t {
+    const std::uint32_t s = source->vector()[v.idx()];
+    return s != kInvalidIndex ? s : n + v.idx();  // vertices an operation made have no source
+  };
+  auto key = [&](Halfedge h) {
+    std::uint64_t a = welded(mesh.from_vertex(h)), b = welded(mesh.to_vertex(h));
+    if (a > b) std::swap(a, b);
+    return a * 2 * n + b;  // a, b < 2n
+  };
+  std::vector<std::uint64_t> face_sides;  // one key per face side of every edge
+  for (Halfedge h : mesh.halfedges())
+    if (!mesh.is_boundary(h)) face_sides.push_back(key(h));
+  std::sort(face_sides.begin(), face_sides.end());
+  std::vector<bool> seam(mesh.edges_size(), false);
+  for (Edge e : mesh.edges()) {
+    if (!mesh.is_boundary(e)) continue;
+    auto [lo, hi] = std::equal_range(face_sides.begin(), face_sides.end(), key(Mesh::halfedge(e, 0)));
+    seam[e.idx()] = hi - lo >= 2;
+  }
+  return seam;
 }
 
 }  // namespace hedge

@@ -248,15 +248,48 @@ TEST(Subdivide, CatmullClarkBoundaryRules) {
   expect_point(mesh.position(Vertex(9 + i.idx())), {{1, 0.5, 0}});
 }
 
-TEST(Subdivide, Sqrt3KeepsBoundaries) {
-  Mesh before = grid(2);
-  Mesh mesh = before;
-  subdivide(mesh, scheme(SubdivisionScheme::sqrt3, 2));
-  expect_valid(mesh);
-  EXPECT_EQ(mesh.n_faces(), before.n_faces() * 9);
-  EXPECT_EQ(topology_stats(mesh).boundary_edges, topology_stats(before).boundary_edges);
-  for (Vertex v : before.vertices())
-    if (before.is_boundary(v)) expect_point(mesh.position(v), at(before, v.idx()));
+TEST(Subdivide, Sqrt3CutsTheBoundaryInThreeEverySecondStep) {
+  const Mesh before = grid(2);  // 8 triangles, 8 boundary edges
+  // Step 1 keeps the boundary as it is.
+  Mesh once = before;
+  subdivide(once, scheme(SubdivisionScheme::sqrt3, 1));
+  expect_valid(once);
+  EXPECT_EQ(once.n_faces(), 24u);
+  EXPECT_EQ(topology_stats(once).boundary_edges, 8u);
+  for (Vertex v : before.vertices()) expect_point(once.position(v), at(before, v.idx()));
+
+  // Step 2 cuts each boundary edge in three: 3 * 24 + 2 * 8 faces.
+  Mesh twice = before;
+  subdivide(twice, scheme(SubdivisionScheme::sqrt3, 2));
+  expect_valid(twice);
+  EXPECT_EQ(twice.n_faces(), 88u);
+  EXPECT_EQ(subdivided_face_count(before, scheme(SubdivisionScheme::sqrt3, 2)), 88u);
+  EXPECT_EQ(topology_stats(twice).boundary_edges, 24u);
+  // Old boundary vertices: (4, 19, 4) / 27 along the boundary; on a straight side they stay,
+  // the corner (0, 0) moves in to (4, 4) / 27.
+  expect_point(twice.position(Vertex(1)), {{1, 0, 0}});
+  expect_point(twice.position(Vertex(0)), {{4.0 / 27, 4.0 / 27, 0}});
+  // New points on the side (0,0)-(1,0): (1, 16, 10) / 27 from the nearer end; every boundary
+  // vertex of the result is one of the rule's points.
+  std::vector<Vec3d> boundary_points;
+  for (Vertex v : twice.vertices())
+    if (twice.is_boundary(v)) boundary_points.push_back(at(twice, v.idx()));
+  EXPECT_EQ(boundary_points.size(), 24u);
+  auto has = [&](Vec3d want) {
+    for (const Vec3d& p : boundary_points)
+      if (norm(p - want) < 1e-6) return true;
+    return false;
+  };
+  EXPECT_TRUE(has({{10.0 / 27, 1.0 / 27, 0}}));  // (0,1) + 16 (0,0) + 10 (1,0)
+  EXPECT_TRUE(has({{18.0 / 27, 0, 0}}));         // 10 (0,0) + 16 (1,0) + (2,0)
+
+  // Four steps: the boundary is cut twice; the face count follows 3F, then + 2 per boundary edge.
+  Mesh four = before;
+  subdivide(four, scheme(SubdivisionScheme::sqrt3, 4));
+  expect_valid(four);
+  EXPECT_EQ(topology_stats(four).boundary_edges, 72u);
+  EXPECT_EQ(four.n_faces(), (88u * 3) * 3 + 2 * 24);
+  EXPECT_EQ(subdivided_face_count(before, scheme(SubdivisionScheme::sqrt3, 4)), four.n_faces());
 }
 
 TEST(Subdivide, MidpointIsLinear) {
@@ -370,8 +403,45 @@ TEST(Subdivide, CornerAndFaceAttributesStayInTheirFace) {
   }
 }
 
-TEST(Subdivide, Sqrt3CarriesCornersAndFaces) {
-  Mesh mesh = grid(2);
+// Two closed tetrahedra glued along edge 0-1 (four faces on it) and a fin (a fifth face on
+// it): build() splits the edge. Every scheme must give back the input's topology there: the
+// edge stays shared by five faces (√3 flips it away: then nothing may be left open).
+TEST(Subdivide, SeamsOfNonManifoldInputStayClosed) {
+  Soup soup;
+  soup.positions = {{{0, 0, 0}}, {{1, 0, 0}}, {{0, 1, 0}}, {{0, 0, 1}}, {{0, -1, 0}}, {{0, 0, -1}}};
+  soup.positions.push_back({{0.5f, 0.5f, 0.5f}});
+  for (std::uint32_t c : {0, 2, 1, 0, 1, 3, 1, 2, 3, 2, 0, 3, 0, 4, 1, 0, 1, 5, 1, 4, 5, 4, 0, 5, 0, 1, 6})
+    soup.corners.push_back(c);
+  soup.face_sizes.assign(9, 3);
+  for (auto s : {SubdivisionScheme::loop, SubdivisionScheme::sqrt3, SubdivisionScheme::catmull_clark,
+                 SubdivisionScheme::midpoint}) {
+    Mesh mesh = build(soup).mesh;
+    subdivide(mesh, scheme(s, 2));
+    expect_valid(mesh);
+    const Soup out = extract(mesh);
+    std::map<std::pair<std::uint32_t, std::uint32_t>, int> faces_on_edge;
+    const auto offsets = out.face_offsets();
+    for (std::size_t f = 0; f < out.n_faces(); ++f)
+      for (std::uint32_t k = offsets[f]; k < offsets[f + 1]; ++k) {
+        const std::uint32_t a = out.corners[k], b = out.corners[k + 1 < offsets[f + 1] ? k + 1 : offsets[f]];
+        ++faces_on_edge[{std::min(a, b), std::max(a, b)}];
+      }
+    std::size_t open = 0, glued = 0;
+    for (const auto& [edge, n] : faces_on_edge) {
+      open += n == 1;
+      glued += n == 5;
+    }
+    if (s == SubdivisionScheme::sqrt3) {
+      EXPECT_EQ(open, 2u * 3);  // only the fin's two free sides, cut in three by the second step
+    } else {
+      EXPECT_EQ(open, 4u * 2) << subdivision_scheme_name(s);  // the fin's free sides, halved twice
+      EXPECT_EQ(glued, 4u) << subdivision_scheme_name(s);     // the glued edge, halved twice
+    }
+  }
+}
+
+Mesh grid_with_uv(int n) {
+  Mesh mesh = grid(n);
   ChannelArray* uv = mesh.halfedge_properties().add_channel("uv", ScalarType::f32, 2);
   for (Face f : mesh.faces())
     for (Halfedge h : mesh.halfedges(f)) {
@@ -379,6 +449,12 @@ TEST(Subdivide, Sqrt3CarriesCornersAndFaces) {
       const float value[2] = {p[0], p[1]};  // one continuous chart: uv = xy
       std::memcpy(uv->element(h.idx()), value, sizeof value);
     }
+  return mesh;
+}
+
+TEST(Subdivide, Sqrt3CarriesCornersAndFaces) {
+  Mesh mesh = grid_with_uv(2);
+  ChannelArray* uv = mesh.halfedge_properties().get_channel("uv");
   auto flipped = mesh.add_face_property<bool>("hedge:flipped", false);
   flipped[Face(3)] = true;
   subdivide(mesh, scheme(SubdivisionScheme::sqrt3));
@@ -404,6 +480,28 @@ TEST(Subdivide, Sqrt3CarriesCornersAndFaces) {
   std::size_t n_flipped = 0;
   for (Face f : mesh.faces()) n_flipped += flipped[f];
   EXPECT_EQ(n_flipped, 3u);  // the three children of face 3
+
+  // The second step of a run cuts the boundary: corners at the new boundary points
+  // (vertices from 17 + 24 on) take the uv a third and two thirds along their edge.
+  mesh = grid_with_uv(2);
+  subdivide(mesh, scheme(SubdivisionScheme::sqrt3, 2));
+  expect_valid(mesh);
+  uv = mesh.halfedge_properties().get_channel("uv");
+  std::size_t on_cut = 0;
+  bool third = false, two_thirds = false;
+  for (Face f : mesh.faces())
+    for (Halfedge h : mesh.halfedges(f)) {
+      if (mesh.to_vertex(h).idx() < 17 + 24) continue;
+      float value[2];
+      std::memcpy(value, uv->element(h.idx()), sizeof value);
+      const bool on_side = value[0] < 1e-6f || value[0] > 2 - 1e-6f || value[1] < 1e-6f || value[1] > 2 - 1e-6f;
+      EXPECT_TRUE(on_side) << value[0] << " " << value[1];
+      third = third || (std::abs(value[0] - 1.0f / 3) < 1e-6f && value[1] == 0);
+      two_thirds = two_thirds || (std::abs(value[0] - 2.0f / 3) < 1e-6f && value[1] == 0);
+      ++on_cut;
+    }
+  EXPECT_GT(on_cut, 0u);
+  EXPECT_TRUE(third && two_thirds);
 }
 
 TEST(Subdivide, RefreshesNormals) {

@@ -44,8 +44,11 @@ std::size_t subdivided_face_count(const Mesh& mesh, const SubdivideOptions& opti
 //! catmull_clark and midpoint take any polygon mesh. Boundaries follow each scheme's
 //! boundary rules: Loop and Catmull–Clark move boundary vertices by the cubic B-spline
 //! curve rule (1/8, 6/8, 1/8) and put boundary edge points at the midpoints, so a boundary
-//! is a curve refined on its own; √3 keeps boundary edges and vertices as they are (a
-//! documented simplification of Kobbelt's two-step boundary rule).
+//! is a curve refined on its own; √3 follows Kobbelt's rule: boundary edges and vertices
+//! stay through odd steps, and every even step (the 2nd, 4th, ... of one call) cuts each
+//! boundary edge in three with the univariate ternary stencils ((1, 16, 10)/27 for the new
+//! points, (4, 19, 4)/27 for the old), so an even number of iterations refines the
+//! boundary as finely as the interior.
 //!
 //! Attributes: vertex properties are blended with the same stencils as positions (integer
 //! channels take the value of the heaviest source); corner properties are blended

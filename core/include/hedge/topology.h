@@ -26,4 +26,10 @@ TopologyStats topology_stats(const Mesh& mesh);
 //! order); returns the number of components.
 std::size_t face_components(const Mesh& mesh, std::vector<Index>& component_of_face);
 
+//! Per edge: true for the boundary edges that are seams of build()'s splits, where the
+//! input's surface goes on: welded through the vertices' sources ("hedge:source"), another
+//! face holds the same edge. All false (empty when `mesh` has no sources) otherwise; real
+//! holes and borders are not seams. O(E log E).
+std::vector<bool> split_seam_edges(const Mesh& mesh);
+
 }  // namespace hedge

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "hedge/error.h"
+#include "hedge/topology.h"
 
 namespace hedge {
 namespace {
@@ -701,34 +702,15 @@ FillHolesReport fill_holes(Mesh& input, const FillHolesOptions& options, Progres
     }
   }
   // Loops along edges that build() split apart (non-manifold input) are no holes: in the
-  // input the surface goes on across every one of their edges. Welded through the vertices'
-  // sources, each such edge is shared by two or more faces; a real hole's edges by one.
-  if (const auto* source = input.vertex_properties().get<std::uint32_t>("hedge:source")) {
-    const std::uint64_t n = input.vertices_size();
-    auto welded = [&](Vertex v) -> std::uint64_t {
-      const std::uint32_t s = source->vector()[v.idx()];
-      return s != std::uint32_t(-1) ? s : n + v.idx();  // vertices made by an operation have none
-    };
-    auto key = [&](Halfedge h) {
-      std::uint64_t a = welded(input.from_vertex(h)), b = welded(input.to_vertex(h));
-      if (a > b) std::swap(a, b);
-      return a * 2 * n + b;  // a, b < 2n
-    };
-    std::vector<std::uint64_t> face_sides;  // one key per face side of every edge
-    for (Halfedge h : input.halfedges())
-      if (!input.is_boundary(h)) face_sides.push_back(key(h));
-    std::sort(face_sides.begin(), face_sides.end());
-    auto shared = [&](Halfedge b) {
-      auto [lo, hi] = std::equal_range(face_sides.begin(), face_sides.end(), key(b));
-      return hi - lo >= 2;
-    };
+  // input the surface goes on across every one of their edges.
+  const std::vector<bool> seam = split_seam_edges(input);
+  if (!seam.empty())
     std::erase_if(holes, [&](const Hole& hole) {
       for (Halfedge b : input.loop(hole.start))
-        if (!shared(b)) return false;
+        if (!seam[Mesh::edge(b).idx()]) return false;
       ++report.split_seams;
       return true;
     });
-  }
   report.holes_found = holes.size();
 
   std::vector<Hole> to_fill;

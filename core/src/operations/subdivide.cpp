@@ -12,10 +12,12 @@
 #include <numbers>
 #include <thread>
 #include <typeinfo>
+#include <tuple>
 #include <vector>
 
 #include "hedge/error.h"
 #include "hedge/normals.h"
+#include "hedge/topology.h"
 #include "parallel.h"
 
 namespace hedge {
@@ -561,11 +563,38 @@ Mesh split_step(const Mesh& m, SubdivisionScheme scheme, unsigned threads, Progr
 
 // ---- √3: a vertex per face, then every interior old edge flipped -----------------------------
 
-Mesh sqrt3_step(const Mesh& m, unsigned threads, Progress& progress, double from, double to) {
+// Kobbelt's boundary rule: every second step (`trisect`) cuts each boundary edge A -> B in
+// three at Q1, Q2, and the boundary triangle's slot (A, B, P_f) becomes (A, Q1, P_f),
+// (Q1, Q2, P_f), (Q2, B, P_f); positions follow the univariate ternary scheme, so two steps
+// refine the boundary curve 1 -> 3 as the interior is refined 1 -> 9. Boundary edge k
+// (numbered in edge order) adds vertices V + F + 2k (Q1) and + 1 (Q2), edges
+// E + 3F + 4k + {0: Q1-Q2, 1: Q2-B, 2: Q1-P_f, 3: Q2-P_f} (side 0 from the first named
+// vertex) and faces 3F + 2k + {0, 1}; the old edge keeps A-Q1.
+Mesh sqrt3_step(const Mesh& m, bool trisect, unsigned threads, Progress& progress, double from, double to) {
   const Index V = Index(m.vertices_size()), E = Index(m.edges_size()), F = Index(m.faces_size());
   const Index H = 2 * E;
-  check_index_range(std::size_t(V) + F, std::size_t(E) + 3 * std::size_t(F), 3 * std::size_t(F));
-  const Index V2 = V + F, E2 = E + 3 * F, F2 = 3 * F;
+  std::vector<Index> boundary_number;  // edge -> k for boundary edges that are cut
+  std::vector<Halfedge> boundary_inner;  // k -> the edge's half-edge inside its face
+  if (trisect) {
+    // Seams of split non-manifold edges stay as they are: the input's surface goes on there,
+    // and their two sides must stay alike to weld back.
+    const std::vector<bool> seam = split_seam_edges(m);
+    boundary_number.assign(E, kInvalidIndex);
+    for (Index e = 0; e < E; ++e)
+      for (unsigned side = 0; side < 2; ++side)
+        if (m.is_boundary(Mesh::halfedge(Edge(e), side)) && (seam.empty() || !seam[e])) {
+          boundary_number[e] = Index(boundary_inner.size());
+          boundary_inner.push_back(Mesh::halfedge(Edge(e), 1 - side));
+        }
+  }
+  const std::size_t B = boundary_inner.size();
+  check_index_range(std::size_t(V) + F + 2 * B, std::size_t(E) + 3 * std::size_t(F) + 4 * B,
+                    3 * std::size_t(F) + 2 * B);
+  const Index V2 = Index(V + F + 2 * B), E2 = Index(E + 3 * F + 4 * B), F2 = Index(3 * F + 2 * B);
+  auto extra_halfedge = [&](Index k, Index which, unsigned side) { return Halfedge(2 * (E + 3 * F + 4 * k + which) + side); };
+  // The boundary half-edge leaving A along the cut edge (B -> Q2) when trisecting.
+  auto is_cut = [&](Halfedge g) { return trisect && boundary_number[Mesh::edge(g).idx()] != kInvalidIndex; };
+  auto boundary_out = [&](Halfedge g) { return is_cut(g) ? extra_halfedge(boundary_number[Mesh::edge(g).idx()], 1, 1) : g; };
 
   // Corner number of every inner half-edge in its triangle (halfedge(f) is corner 0).
   std::vector<std::uint8_t> corner(H, 0);
@@ -599,6 +628,58 @@ Mesh sqrt3_step(const Mesh& m, unsigned threads, Progress& progress, double from
         const Halfedge g = Mesh::opposite(h);
         const Halfedge a = spoke(f, i, 1);
         Halfedge b, c;
+        if (m.is_boundary(g) && is_cut(g)) {
+          const Index k = boundary_number[Mesh::edge(h).idx()];
+          const Vertex q1(V + F + 2 * k), q2(V + F + 2 * k + 1), corner_b = m.to_vertex(h);
+          const Halfedge s1 = extra_halfedge(k, 0, 0), s2 = extra_halfedge(k, 1, 0);
+          const Halfedge x = extra_halfedge(k, 2, 0), y = extra_halfedge(k, 3, 0);  // Q1 -> P_f, Q2 -> P_f
+          const Halfedge to_a = spoke(f, i + 2, 0);                                  // P_f -> A
+          out.set_vertex(h, q1);
+          out.set_vertex(x, pf);
+          out.set_vertex(Mesh::opposite(x), q1);
+          out.set_vertex(s1, q2);
+          out.set_vertex(Mesh::opposite(s1), q1);
+          out.set_vertex(y, pf);
+          out.set_vertex(Mesh::opposite(y), q2);
+          out.set_vertex(s2, corner_b);
+          out.set_vertex(Mesh::opposite(s2), q2);
+          const Face t1(3 * F + 2 * k), t2(3 * F + 2 * k + 1);
+          const Halfedge loops[3][3] = {{h, x, to_a}, {s1, y, Mesh::opposite(x)}, {s2, a, Mesh::opposite(y)}};
+          const Face faces[3] = {t, t1, t2};
+          for (int j = 0; j < 3; ++j) {
+            for (int l = 0; l < 3; ++l) {
+              out.set_next(loops[j][l], loops[j][(l + 1) % 3]);
+              out.set_face(loops[j][l], faces[j]);
+            }
+            out.set_halfedge(faces[j], loops[j][0]);
+            if (face_props) fmap[faces[j].idx()] = f;
+          }
+          // Along the boundary: B -> Q2 -> Q1 -> A (g keeps Q1 -> A; the edge loop links g on).
+          out.set_next(Mesh::opposite(s2), Mesh::opposite(s1));
+          out.set_next(Mesh::opposite(s1), g);
+          out.set_halfedge(q1, g);
+          out.set_halfedge(q2, Mesh::opposite(s1));
+          if (corner_props) {
+            const Index q1_slot = H + F + 2 * k, q2_slot = q1_slot + 1;
+            hmap[h.idx()] = q1_slot;
+            hmap[x.idx()] = H + f;
+            hmap[to_a.idx()] = m.prev(h).idx();
+            hmap[s1.idx()] = q2_slot;
+            hmap[y.idx()] = H + f;
+            hmap[Mesh::opposite(x).idx()] = q1_slot;
+            hmap[s2.idx()] = h.idx();
+            hmap[a.idx()] = H + f;
+            hmap[Mesh::opposite(y).idx()] = q2_slot;
+            hmap[Mesh::opposite(s1).idx()] = g.idx();  // boundary: the old boundary's defaults
+            hmap[Mesh::opposite(s2).idx()] = g.idx();
+          }
+          if (edge_props) {
+            emap[E + 3 * F + 4 * k] = emap[E + 3 * F + 4 * k + 1] = Mesh::edge(h).idx();
+            emap[E + 3 * F + 4 * k + 2] = emap[E + 3 * F + 4 * k + 3] = E;
+            emap[E + 3 * f + i] = E;
+          }
+          continue;
+        }
         if (m.is_boundary(g)) {
           out.set_vertex(h, m.to_vertex(h));
           b = spoke(f, i + 2, 0);  // P_f -> c_{i-1}
@@ -640,7 +721,7 @@ Mesh sqrt3_step(const Mesh& m, unsigned threads, Progress& progress, double from
         const Halfedge h = Mesh::halfedge(Edge(e), side);
         if (!m.is_boundary(h)) continue;
         out.set_vertex(h, m.to_vertex(h));
-        out.set_next(h, m.next(h));
+        out.set_next(h, boundary_out(m.next(h)));
         if (corner_props) hmap[h.idx()] = h.idx();
       }
       if (edge_props) emap[e] = e;
@@ -651,7 +732,7 @@ Mesh sqrt3_step(const Mesh& m, unsigned threads, Progress& progress, double from
   for (Index v = 0; v < V; ++v) {
     const Halfedge h = m.halfedge(Vertex(v));
     if (!h.is_valid() || m.is_boundary(h)) {
-      out.set_halfedge(Vertex(v), h);
+      out.set_halfedge(Vertex(v), h.is_valid() ? boundary_out(h) : h);
     } else {
       const Halfedge in = m.prev(h);  // points to v inside face(h)
       out.set_halfedge(Vertex(v), spoke(m.face(h).idx(), corner[in.idx()], 1));
@@ -660,14 +741,34 @@ Mesh sqrt3_step(const Mesh& m, unsigned threads, Progress& progress, double from
 
   VertexRule rule;
   rule.V = V;
-  rule.added = F;
-  rule.phases = {{0, F}};
-  auto added = [&](Index f, Stencil& s) {
-    for (Vertex c : m.vertices(Face(f))) s.add(c.idx(), 1.0f / 3.0f);
+  rule.added = Index(F + 2 * B);
+  rule.phases = {{0, rule.added}};
+  auto added = [&](Index n, Stencil& s) {
+    if (n < F) {
+      for (Vertex c : m.vertices(Face(n))) s.add(c.idx(), 1.0f / 3.0f);
+      return;
+    }
+    // The ternary rule: the point a third of the way from A to B is (10 B + 16 A + A') / 27,
+    // A' being A's other neighbour along the boundary.
+    const Halfedge h = boundary_inner[(n - F) / 2], g = Mesh::opposite(h);
+    const bool near_a = (n - F) % 2 == 0;
+    const Vertex near = near_a ? m.from_vertex(h) : m.to_vertex(h), far = near_a ? m.to_vertex(h) : m.from_vertex(h);
+    const Vertex beyond = near_a ? m.to_vertex(m.next(g)) : m.from_vertex(m.prev(g));
+    s.add(beyond.idx(), 1.0f / 27);
+    s.add(near.idx(), 16.0f / 27);
+    s.add(far.idx(), 10.0f / 27);
   };
   auto even = [&](Vertex v, Stencil& s) {
-    if (m.is_boundary(v)) {  // boundary curves are kept (see subdivide.h)
-      s.add(v.idx(), 1.0f);
+    if (m.is_boundary(v)) {
+      const Halfedge out_h = m.halfedge(v);  // boundary: v -> next along the boundary
+      // The boundary curve waits for the next step; isolated vertices and seams stay.
+      if (!out_h.is_valid() || !is_cut(out_h) || !is_cut(m.prev(out_h))) {
+        s.add(v.idx(), 1.0f);
+        return;
+      }
+      s.add(m.from_vertex(m.prev(out_h)).idx(), 4.0f / 27);
+      s.add(v.idx(), 19.0f / 27);
+      s.add(m.to_vertex(out_h).idx(), 4.0f / 27);
       return;
     }
     const std::size_t n = m.valence(v);
@@ -678,13 +779,25 @@ Mesh sqrt3_step(const Mesh& m, unsigned threads, Progress& progress, double from
   refine_vertices(m, out, rule, threads, added, even);
   progress.update(from + 0.8 * (to - from), "subdividing: attributes");
 
-  refine_corners(m, out, F, hmap, threads, [&](const std::vector<Target>& all, unsigned t) {
+  refine_corners(m, out, F + 2 * B, hmap, threads, [&](const std::vector<Target>& all, unsigned t) {
     parallel_for(F, t, [&](std::size_t lo, std::size_t hi) {
       const float third[3] = {1.0f / 3, 1.0f / 3, 1.0f / 3};
       for (Index f = Index(lo); f < hi; ++f) {
         const Halfedge h = m.halfedge(Face(f));
         const Index sources[3] = {h.idx(), m.next(h).idx(), m.prev(h).idx()};
         for (const Target& x : all) blend(x, H + f, sources, third);
+      }
+    });
+    // Corners at Q1 and Q2 lie on the edge A -> B of their face: a third and two thirds along.
+    parallel_for(B, t, [&](std::size_t lo, std::size_t hi) {
+      const float near_a[2] = {2.0f / 3, 1.0f / 3}, near_b[2] = {1.0f / 3, 2.0f / 3};
+      for (std::size_t k = lo; k < hi; ++k) {
+        const Halfedge h = boundary_inner[k];
+        const Index sources[2] = {m.prev(h).idx(), h.idx()};  // the corners at A and B
+        for (const Target& x : all) {
+          blend(x, H + F + 2 * k, sources, near_a);
+          blend(x, H + F + 2 * k + 1, sources, near_b);
+        }
       }
     });
   });
@@ -699,9 +812,47 @@ Mesh sqrt3_step(const Mesh& m, unsigned threads, Progress& progress, double from
   return out;
 }
 
+//! On non-manifold input, build() split edges into copies of one input edge. Each copy gets
+//! its own edge point (vertex V + e of a split step); giving them one new source lets
+//! extract() weld them, so the host's surface keeps the input's edge and gets no crack
+//! (the welded point takes the first copy's position). New sources are numbered after the
+//! largest one in use, in the order of the welded edges they sit on.
+void weld_split_edge_points(const Mesh& before, Mesh& after) {
+  const auto* old_source = before.vertex_properties().get<std::uint32_t>("hedge:source");
+  auto* source = after.vertex_properties().get<std::uint32_t>("hedge:source");
+  if (!old_source || !source) return;
+  const Index V = Index(before.vertices_size());
+  std::uint64_t next = 0;
+  for (std::uint32_t s : old_source->vector())
+    if (s != kInvalidIndex) next = std::max<std::uint64_t>(next, std::uint64_t(s) + 1);
+  auto welded = [&](Vertex v) -> std::uint64_t {
+    const std::uint32_t s = old_source->vector()[v.idx()];
+    return s != kInvalidIndex ? s : (std::uint64_t(1) << 32) + v.idx();  // unique when it has none
+  };
+  std::vector<std::tuple<std::uint64_t, std::uint64_t, Index>> edges;  // (welded ends, edge)
+  for (Edge e : before.edges()) {
+    const std::uint64_t a = welded(before.vertex(e, 0)), b = welded(before.vertex(e, 1));
+    edges.emplace_back(std::min(a, b), std::max(a, b), e.idx());
+  }
+  std::sort(edges.begin(), edges.end());
+  auto same = [&](std::size_t i, std::size_t j) {
+    return std::get<0>(edges[i]) == std::get<0>(edges[j]) && std::get<1>(edges[i]) == std::get<1>(edges[j]);
+  };
+  for (std::size_t i = 0; i < edges.size();) {
+    std::size_t j = i + 1;
+    while (j < edges.size() && same(i, j)) ++j;
+    if (j - i > 1) {
+      if (next >= kInvalidIndex) return;  // out of numbers: leave the rest unwelded
+      for (std::size_t k = i; k < j; ++k) source->vector()[V + std::get<2>(edges[k])] = std::uint32_t(next);
+      ++next;
+    }
+    i = j;
+  }
+}
+
 //! Faces by kind, in one pass: what the refusals and the size forecast need.
 struct FaceCensus {
-  std::size_t faces = 0, triangles = 0, corners = 0;
+  std::size_t faces = 0, triangles = 0, corners = 0, boundary_edges = 0;
 };
 
 FaceCensus face_census(const Mesh& mesh) {
@@ -712,6 +863,7 @@ FaceCensus face_census(const Mesh& mesh) {
     c.triangles += n == 3;
     c.corners += n;
   }
+  for (Edge e : mesh.edges()) c.boundary_edges += mesh.is_boundary(e) ? 1 : 0;
   return c;
 }
 
@@ -744,6 +896,18 @@ std::size_t forecast_faces(const FaceCensus& c, const SubdivideOptions& options)
     case SubdivisionScheme::midpoint:
       first = 4.0 * double(c.triangles) + double(c.corners - 3 * c.triangles);
       break;
+  }
+  if (options.scheme == SubdivisionScheme::sqrt3 && c.boundary_edges) {
+    // Every second step cuts each boundary edge in three, adding two triangles for each.
+    double faces = double(c.faces), boundary = double(c.boundary_edges);
+    for (int it = 0; it < options.iterations && faces < 1e18; ++it) {
+      faces *= 3;
+      if (it % 2 == 1) {
+        faces += 2 * boundary;
+        boundary *= 3;
+      }
+    }
+    return faces >= 1e18 ? std::size_t(1e18) : std::size_t(faces);
   }
   const double factor = options.scheme == SubdivisionScheme::sqrt3 ? 3.0 : 4.0;
   const double total = first * std::pow(factor, options.iterations - 1);
@@ -809,8 +973,9 @@ SubdivideReport subdivide(Mesh& mesh, const SubdivideOptions& options, Progress&
     const double from = double(it) / options.iterations, to = double(it + 1) / options.iterations;
     progress.update(from, "subdividing: step " + std::to_string(it + 1) + " of " + std::to_string(options.iterations));
     Mesh next = options.scheme == SubdivisionScheme::sqrt3
-                    ? sqrt3_step(*current, options.threads, progress, from, to)
+                    ? sqrt3_step(*current, it % 2 == 1, options.threads, progress, from, to)
                     : split_step(*current, options.scheme, options.threads, progress, from, to);
+    if (options.scheme != SubdivisionScheme::sqrt3) weld_split_edge_points(*current, next);
     result = std::move(next);
     current = &result;
   }
@@ -838,7 +1003,8 @@ Operation subdivide_operation() {
       "per triangle and the old edges flipped, the face count triples per step, for triangle meshes), midpoint "
       "(no smoothing: triangles 1 to 4 at the edge midpoints, other polygons into quads around their centroid). "
       "loop and sqrt3 refuse meshes with polygons: run Triangulate first. Boundaries: loop and catmull_clark "
-      "refine boundary curves with the cubic B-spline rule; sqrt3 keeps boundary edges and vertices fixed. "
+      "refine boundary curves with the cubic B-spline rule; sqrt3 follows Kobbelt's rule, cutting boundary edges "
+      "in three on every second iteration of a run (use an even number of iterations on open meshes). "
       "Attributes: vertex attributes are blended with the scheme's own weights, corner attributes (UVs) linearly "
       "inside each old face so seams stay seams, face attributes (materials) are copied to the child faces; normals "
       "are recomputed for the new shape. "
