@@ -463,8 +463,10 @@ class Builder {
     const std::uint32_t ne = edges_in[0] + edges_in[1];
 
     Mesh& mesh = result_.mesh;
-    mesh.resize(nv_, ne, nf_);
-    if (nv_) std::memcpy(mesh.positions().data(), soup_.positions.data(), nv_ * sizeof(Point));
+    // The connectivity arrays are allocated unset and written below, every field exactly
+    // once, on both threads: their first touch is those writes.
+    mesh.positions().assign(soup_.positions.begin(), soup_.positions.end());
+    mesh.resize_unset(nv_, ne, nf_);
     parallel_ranges(nf_, [&](std::size_t fbegin, std::size_t fend) {
       for (std::size_t fi = fbegin; fi < fend; ++fi) {
         const std::uint32_t b = soff_[fi], e = soff_[fi + 1];
@@ -476,7 +478,10 @@ class Builder {
           mesh.set_vertex(h, Vertex(corner_[m]));
           mesh.set_face(h, f);
           mesh.set_next(Halfedge(H[prev]), h);
-          if (out_twin[prev] == kInv) mesh.set_vertex(opposite(h), Vertex(corner_[prev]));
+          if (out_twin[prev] == kInv) {  // a boundary: the outer half is this face's to set
+            mesh.set_vertex(opposite(h), Vertex(corner_[prev]));
+            mesh.set_face(opposite(h), Face());
+          }
           prev = m;
         }
       }
@@ -485,7 +490,10 @@ class Builder {
     // leaving it.
     parallel_ranges(nv_, [&](std::size_t vbegin, std::size_t vend) {
       for (std::size_t v = vbegin; v < vend; ++v) {
-        if (vfirst[v] == kInv) continue;
+        if (vfirst[v] == kInv) {  // isolated, or several fans (set below)
+          mesh.set_halfedge(Vertex(static_cast<Index>(v)), Halfedge());
+          continue;
+        }
         const Halfedge out(H[vfirst[v]] ^ 1u);
         mesh.set_halfedge(Vertex(static_cast<Index>(v)), out);
         if (vlast[v] != kInv) mesh.set_next(opposite(mesh.next(Halfedge(H[vlast[v]]))), out);

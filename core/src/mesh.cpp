@@ -45,7 +45,7 @@ void check_capacity(std::size_t count, const char* what) {
 
 Vertex Mesh::new_vertex() {
   check_capacity(vertices_size() + 1, "vertices");
-  vertex_halfedge_.emplace_back();
+  vertex_halfedge_.push_back(Halfedge());
   positions_.emplace_back();
   vprops_.push_back();
   if (deleted_vertices_) vdeleted_.push_back(false);
@@ -65,16 +65,25 @@ Halfedge Mesh::new_edge(Vertex from, Vertex to) {
 
 Face Mesh::new_face() {
   check_capacity(faces_size() + 1, "faces");
-  face_halfedge_.emplace_back();
+  face_halfedge_.push_back(Halfedge());
   fprops_.push_back();
   if (deleted_faces_) fdeleted_.push_back(false);
   return Face(static_cast<Index>(faces_size() - 1));
 }
 
 void Mesh::resize(std::size_t vertices, std::size_t edges, std::size_t faces) {
+  const std::size_t v0 = vertices_size(), h0 = halfedges_size(), f0 = faces_size();
+  resize_unset(vertices, edges, faces);
+  if (vertices > v0) std::fill(vertex_halfedge_.begin() + v0, vertex_halfedge_.end(), Halfedge());
+  if (2 * edges > h0) std::fill(halfedges_.begin() + h0, halfedges_.end(), HalfedgeRecord{});
+  if (faces > f0) std::fill(face_halfedge_.begin() + f0, face_halfedge_.end(), Halfedge());
+}
+
+void Mesh::resize_unset(std::size_t vertices, std::size_t edges, std::size_t faces) {
   check_capacity(vertices, "vertices");
   check_capacity(2 * edges, "half-edges");
   check_capacity(faces, "faces");
+  const std::size_t v0 = vertices_size(), h0 = halfedges_size(), f0 = faces_size();
   vertex_halfedge_.resize(vertices);
   positions_.resize(vertices);
   vprops_.resize(vertices);
@@ -86,6 +95,17 @@ void Mesh::resize(std::size_t vertices, std::size_t edges, std::size_t faces) {
   if (deleted_vertices_) vdeleted_.resize(vertices, false);
   if (deleted_edges_) edeleted_.resize(edges, false);
   if (deleted_faces_) fdeleted_.resize(faces, false);
+#ifndef NDEBUG
+  // Debug builds poison what was left unset, so a builder that misses a field fails validate().
+  const Index poison = 0x5a5a5a5au;
+  if (vertices > v0) std::fill(vertex_halfedge_.begin() + v0, vertex_halfedge_.end(), Halfedge(poison));
+  if (2 * edges > h0)
+    std::fill(halfedges_.begin() + h0, halfedges_.end(),
+              HalfedgeRecord{Vertex(poison), Face(poison), Halfedge(poison), Halfedge(poison)});
+  if (faces > f0) std::fill(face_halfedge_.begin() + f0, face_halfedge_.end(), Halfedge(poison));
+#else
+  (void)v0, (void)h0, (void)f0;
+#endif
 }
 
 void Mesh::adjust_outgoing_halfedge(Vertex v) {
@@ -238,9 +258,9 @@ void compaction_maps(std::size_t n, IsDeleted is_deleted, std::vector<Index>& ol
     }
 }
 
-template <class T>
-void gather(std::vector<T>& data, const std::vector<Index>& new_to_old) {
-  std::vector<T> out;
+template <class Array>
+void gather(Array& data, const std::vector<Index>& new_to_old) {
+  Array out;
   out.reserve(new_to_old.size());
   for (Index i : new_to_old) out.push_back(data[i]);
   data.swap(out);

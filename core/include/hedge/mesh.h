@@ -15,8 +15,11 @@
 #include <cstddef>
 #include <cstdint>
 #include <iterator>
+#include <memory>
 #include <span>
 #include <string>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "hedge/handles.h"
@@ -116,6 +119,30 @@ struct LoopRange {
   LoopIterator<S, Y> end() const { return {mesh, start, true}; }
 };
 
+//! std::allocator, except that an element made without a value (resize(n), emplace_back())
+//! is left unset. The mesh's connectivity arrays use it so that a builder that writes every
+//! field itself (Mesh::resize_unset) does not pay for a fill first: on a big mesh that fill
+//! is one thread taking every page fault of tens of megabytes, which the builder's own
+//! writes, spread over its threads, take anyway.
+template <class T>
+struct UnsetAllocator : std::allocator<T> {
+  static_assert(std::is_trivially_copyable_v<T> && std::is_trivially_destructible_v<T>);
+  using value_type = T;
+  UnsetAllocator() = default;
+  template <class U>
+  UnsetAllocator(const UnsetAllocator<U>&) noexcept {}
+  template <class U>
+  struct rebind {
+    using other = UnsetAllocator<U>;
+  };
+  template <class U>
+  void construct(U*) noexcept {}
+  template <class U, class... Args>
+  void construct(U* p, Args&&... args) {
+    std::construct_at(p, std::forward<Args>(args)...);
+  }
+};
+
 }  // namespace detail
 
 //! Index maps returned by garbage_collect(): old index -> new index (invalid when deleted).
@@ -201,6 +228,12 @@ class Mesh {
   Face new_face();
   //! Bulk allocation for builders: appends n elements with invalid connectivity.
   void resize(std::size_t vertices, std::size_t edges, std::size_t faces);
+  //! As resize(), but the connectivity of the new elements is left unset (garbage): for
+  //! builders that then set every field themselves, on several threads, so that the new
+  //! memory is touched once. Precondition for the mesh to be valid again: the caller sets
+  //! to_vertex, face, next and prev of every new half-edge, and halfedge() of every new
+  //! vertex and face (invalid ones included). Positions and properties are initialised.
+  void resize_unset(std::size_t vertices, std::size_t edges, std::size_t faces);
 
   // ---- geometry ----------------------------------------------------------------------
   Point& position(Vertex v) { return positions_[v.idx()]; }
@@ -382,9 +415,11 @@ class Mesh {
   void mark_deleted(Edge e);
   void mark_deleted(Face f);
 
-  std::vector<HalfedgeRecord> halfedges_;
-  std::vector<Halfedge> vertex_halfedge_;
-  std::vector<Halfedge> face_halfedge_;
+  template <class T>
+  using Array = std::vector<T, detail::UnsetAllocator<T>>;
+  Array<HalfedgeRecord> halfedges_;
+  Array<Halfedge> vertex_halfedge_;
+  Array<Halfedge> face_halfedge_;
   std::vector<Point> positions_;
   PropertyContainer vprops_, hprops_, eprops_, fprops_;
   std::vector<bool> vdeleted_, edeleted_, fdeleted_;
