@@ -525,6 +525,14 @@ bool Mesh::is_collapse_ok(Halfedge h) const { return collapse_refusal(*this, h) 
 // are removed by merging their two remaining edges.
 void Mesh::collapse(Halfedge h) {
   if (const char* why = collapse_refusal(*this, h)) throw Error(refused("collapse", "half-edge " + id(h.idx()), why));
+  collapse_unchecked(h);
+}
+
+void Mesh::collapse_unchecked(Halfedge h) {
+#ifndef NDEBUG
+  if (const char* why = collapse_refusal(*this, h))
+    throw Error(refused("collapse_unchecked", "half-edge " + id(h.idx()), why) + " (the caller's precondition)");
+#endif
   Halfedge o = opposite(h);
   Vertex v0 = to_vertex(o), v1 = to_vertex(h);
   Halfedge hn = next(h), hp = prev(h), on = next(o), op = prev(o);

@@ -61,15 +61,21 @@ void blend(std::byte* to, const ChannelArray& c, std::span<const Index> from, st
 
 void ChannelArray::interpolate(std::size_t to, std::span<const Index> from, std::span<const float> weights) {
   if (from.empty()) return;
-  // Only real numbers blend; integer channels (ids, flags, 8-bit colours are blended too,
-  // rounded) take the value of the heaviest source otherwise.
-  std::vector<std::byte> out(stride_);
+  // Only real numbers blend; integer channels (ids, flags, 8-bit colours) take the value of
+  // the heaviest source. Written in place, without a buffer (this runs once per collapse or
+  // split): blend() reads component k of every source before it writes component k, so
+  // `to` may be one of the sources.
   switch (scalar_) {
-    case ScalarType::f32: blend<float>(out.data(), *this, from, weights); break;
-    case ScalarType::f64: blend<double>(out.data(), *this, from, weights); break;
-    default: std::memcpy(out.data(), element(from[detail::largest_weight(weights)]), stride_); break;
+    case ScalarType::f32:
+      blend<float>(element(to), *this, from, weights);
+      break;
+    case ScalarType::f64:
+      blend<double>(element(to), *this, from, weights);
+      break;
+    default:
+      std::memmove(element(to), element(from[detail::largest_weight(weights)]), stride_);
+      break;
   }
-  std::memcpy(element(to), out.data(), stride_);
 }
 
 void ChannelArray::permute(std::span<const Index> new_to_old) {

@@ -388,6 +388,11 @@ class Mesh {
   //! triangles (larger polygons lose a corner). Throws Error, changing nothing, unless
   //! is_collapse_ok(h).
   void collapse(Halfedge h);
+  //! collapse(h) without its legality test, for callers that have just made that test, or
+  //! a stricter one, on the mesh as it is (decimate does; the test walks both one-rings and
+  //! costs as much as the collapse). Precondition: is_collapse_ok(h); otherwise the mesh is
+  //! left broken. Debug builds check the precondition and throw Error when it fails.
+  void collapse_unchecked(Halfedge h);
 
   //! Splits f into triangles by a fan of new edges from corner 0 (no geometry involved;
   //! the triangulate operation chooses diagonals by shape); O(corners). When a diagonal
