@@ -358,7 +358,7 @@ Vec3d TriangleTree::box_max() const {
   return {{nodes_[0].hi[0], nodes_[0].hi[1], nodes_[0].hi[2]}};
 }
 
-void TriangleTree::search(const Vec3d& p, ClosestPoint& best, double& best_sq) const {
+void TriangleTree::search(const Vec3d& p, ClosestPoint& best, double& best_sq, const Vec3d* facing) const {
   if (nodes_.empty()) return;
   struct Entry {
     Index node;
@@ -376,6 +376,8 @@ void TriangleTree::search(const Vec3d& p, ClosestPoint& best, double& best_sq) c
       if (node.count) {
         for (Index i = node.index, end = node.index + node.count; i < end; ++i) {
           const Triangle& t = triangles_[i];
+          if (facing && !(dot(cross(to_double(t.b) - to_double(t.a), to_double(t.c) - to_double(t.a)), *facing) > 0))
+            continue;
           ClosestPoint c = closest_point_on_triangle(p, to_double(t.a), to_double(t.b), to_double(t.c));
           double d_sq = c.distance * c.distance;
           if (d_sq < best_sq) {
@@ -406,6 +408,14 @@ ClosestPoint TriangleTree::closest_point(const Vec3d& p, double max_distance) co
   double best_sq = max_distance * max_distance;
   if (std::isinf(max_distance)) best_sq = std::numeric_limits<double>::infinity();
   search(p, best, best_sq);
+  return best;
+}
+
+ClosestPoint TriangleTree::closest_point_facing(const Vec3d& p, const Vec3d& direction, double max_distance) const {
+  ClosestPoint best;
+  double best_sq = max_distance * max_distance;
+  if (std::isinf(max_distance)) best_sq = std::numeric_limits<double>::infinity();
+  search(p, best, best_sq, &direction);
   return best;
 }
 
@@ -648,6 +658,37 @@ HausdorffResult hausdorff(const Mesh& a, const Mesh& b, const HausdorffOptions& 
   r.b_to_a = one_sided_distance(b, tree_a, options);
   r.max = std::max(r.a_to_b.max, r.b_to_a.max);
   return r;
+}
+
+std::size_t flipped_faces(const Mesh& mesh, const TriangleTree& reference) {
+  std::size_t flipped = 0;
+  std::vector<Vec3d> corners;
+  for (Face f : mesh.faces()) {
+    corners.clear();
+    for (Vertex v : mesh.vertices(f)) corners.push_back(to_double(mesh.position(v)));
+    // Newell's normal of the face (any polygon), and a triangle of its corners for the points.
+    Vec3d normal{};
+    for (std::size_t i = 0; i < corners.size(); ++i) normal += cross(corners[i], corners[(i + 1) % corners.size()]);
+    if (corners.size() < 3 || sqrnorm(normal) == 0) continue;
+    const Vec3d &a = corners[0], &b = corners[corners.size() / 2], &c = corners.back();
+    double longest = 0;
+    for (std::size_t i = 0; i < corners.size(); ++i)
+      longest = std::max(longest, distance(corners[i], corners[(i + 1) % corners.size()]));
+    int against = 0;
+    for (const Vec3d& w : {Vec3d{{1.0 / 3, 1.0 / 3, 1.0 / 3}}, Vec3d{{2.0 / 3, 1.0 / 6, 1.0 / 6}},
+                           Vec3d{{1.0 / 6, 2.0 / 3, 1.0 / 6}}, Vec3d{{1.0 / 6, 1.0 / 6, 2.0 / 3}}}) {
+      const Vec3d p = a * w[0] + b * w[1] + c * w[2];
+      const ClosestPoint cp = reference.closest_point(p);
+      if (!cp.found()) continue;
+      const auto t = reference.corners(cp.triangle);
+      if (!(dot(cross(t[1] - t[0], t[2] - t[0]), normal) < 0)) continue;
+      // A layer of the reference facing the same way close by (a thin part, two sides of
+      // a sheet) makes the nearest triangle ambiguous: not counted.
+      if (!reference.closest_point_facing(p, normal, cp.distance + 0.5 * longest).found()) ++against;
+    }
+    if (against >= 3) ++flipped;
+  }
+  return flipped;
 }
 
 }  // namespace hedge

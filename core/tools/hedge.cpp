@@ -1,6 +1,7 @@
 // The `hedge` command line: info, convert, and every catalogue operation
 // (`hedge OP IN OUT --param value`), generated from the catalogue.
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <iostream>
 #include <map>
@@ -9,8 +10,10 @@
 
 #include "hedge/build.h"
 #include "hedge/catalogue.h"
+#include "hedge/distance.h"
 #include "hedge/error.h"
 #include "hedge/io.h"
+#include "hedge/report.h"
 #include "hedge/topology.h"
 
 namespace {
@@ -21,6 +24,9 @@ constexpr const char* kUsage =
     "usage:\n"
     "  hedge info FILE [--json]          counts, topology and what building repaired\n"
     "  hedge convert IN OUT [--ascii]    between OFF, OBJ, PLY and STL\n"
+    "  hedge distance A B [--json] [--samples-per-face N]\n"
+    "                                    symmetric Hausdorff distance between two meshes (sampled),\n"
+    "                                    and the faces of B turned over against A\n"
     "  hedge list                        every operation with its parameters\n"
     "  hedge help OP                     one operation in full\n"
     "  hedge OP IN [OUT] [--param value ...] [--json] [--ascii]\n"
@@ -42,9 +48,9 @@ std::string id_of(const std::string& flag) {
 
 std::string json_repairs(const BuildReport& r) {
   auto n = [](std::size_t x) { return std::to_string(x); };
-  return "{\"non_manifold_edges\": " + n(r.non_manifold_edges) + ", \"non_manifold_vertices\": " +
-         n(r.non_manifold_vertices) + ", \"vertex_copies\": " + n(r.vertex_copies) + ", \"flipped_faces\": " +
-         n(r.flipped_faces) + ", \"unorientable_edges\": " + n(r.unorientable_edges) +
+  return "{\"non_manifold_edges\": " + n(r.non_manifold_edges) +
+         ", \"non_manifold_vertices\": " + n(r.non_manifold_vertices) + ", \"vertex_copies\": " + n(r.vertex_copies) +
+         ", \"flipped_faces\": " + n(r.flipped_faces) + ", \"unorientable_edges\": " + n(r.unorientable_edges) +
          ", \"repeated_vertex_faces\": " + n(r.repeated_vertex_faces) + ", \"skipped_faces\": " + n(r.skipped_faces) +
          ", \"isolated_vertices\": " + n(r.isolated_vertices) + "}";
 }
@@ -54,9 +60,12 @@ int info(const std::vector<std::string>& args) {
   bool json = false;
   std::string path;
   for (const auto& a : args) {
-    if (a == "--json") json = true;
-    else if (a.rfind("--", 0) == 0) throw Error("info: unknown option " + a);
-    else path = a;
+    if (a == "--json")
+      json = true;
+    else if (a.rfind("--", 0) == 0)
+      throw Error("info: unknown option " + a);
+    else
+      path = a;
   }
   Soup soup = read_mesh(path);
   BuildResult built = build(soup);
@@ -94,9 +103,12 @@ int convert(const std::vector<std::string>& args) {
   std::vector<std::string> files;
   WriteOptions options;
   for (const auto& a : args) {
-    if (a == "--ascii") options.binary = false;
-    else if (a.rfind("--", 0) == 0) throw Error("convert: unknown option " + a);
-    else files.push_back(a);
+    if (a == "--ascii")
+      options.binary = false;
+    else if (a.rfind("--", 0) == 0)
+      throw Error("convert: unknown option " + a);
+    else
+      files.push_back(a);
   }
   if (files.size() != 2) throw Error("convert: needs IN and OUT\n" + std::string(kUsage));
   format_from_path(files[1]);  // refuse an unknown output format before reading
@@ -104,9 +116,64 @@ int convert(const std::vector<std::string>& args) {
   return 0;
 }
 
+// `hedge distance A B`: how far two meshes are apart (e.g. a decimated mesh and its input),
+// with the same sampler the tests use, relative to A's bounding-box diagonal.
+int distance_command(const std::vector<std::string>& args) {
+  std::vector<std::string> files;
+  bool json = false;
+  HausdorffOptions options;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    if (a == "--json") {
+      json = true;
+    } else if (a == "--samples-per-face") {
+      if (i + 1 == args.size()) throw Error("distance: --samples-per-face needs a value");
+      const std::string text = args[++i];
+      char* end = nullptr;
+      options.sample_density = std::strtod(text.c_str(), &end);
+      if (end == text.c_str() || *end || !(options.sample_density >= 0 && options.sample_density <= 1000))
+        throw Error("distance: --samples-per-face must be a number from 0 to 1000, not '" + text + "'");
+    } else if (a.rfind("--", 0) == 0) {
+      throw Error("distance: unknown option " + a);
+    } else {
+      files.push_back(a);
+    }
+  }
+  if (files.size() != 2) throw Error("distance: needs two files, A and B\n" + std::string(kUsage));
+  const Mesh a = build(read_mesh(files[0])).mesh, b = build(read_mesh(files[1])).mesh;
+  if (a.n_faces() == 0 || b.n_faces() == 0) throw Error("distance: " + files[a.n_faces() ? 1 : 0] + " has no faces");
+  const double diagonal = mesh_statistics(a).bbox_diagonal;
+  const HausdorffResult h = hausdorff(a, b, options);
+  const std::size_t flipped = flipped_faces(b, TriangleTree(a));
+  const double scale = diagonal > 0 ? 1 / diagonal : 0;
+  if (json) {
+    auto side = [&](const OneSidedDistance& d) {
+      char buf[256];
+      std::snprintf(buf, sizeof buf, "{\"max\": %.9g, \"mean\": %.9g, \"rms\": %.9g, \"samples\": %zu}", d.max, d.mean,
+                    d.rms, d.samples);
+      return std::string(buf);
+    };
+    std::printf(
+        "{\"hausdorff\": %.9g, \"hausdorff_over_diagonal\": %.9g, \"diagonal\": %.9g, \"a_to_b\": %s, "
+        "\"b_to_a\": %s, \"faces_a\": %zu, \"faces_b\": %zu, \"flipped_faces\": %zu}\n",
+        h.max, h.max * scale, diagonal, side(h.a_to_b).c_str(), side(h.b_to_a).c_str(), a.n_faces(), b.n_faces(),
+        flipped);
+    return 0;
+  }
+  std::printf("A %s: %zu faces; B %s: %zu faces\n", files[0].c_str(), a.n_faces(), files[1].c_str(), b.n_faces());
+  std::printf("  symmetric Hausdorff   %.6g (%.6g of A's bounding-box diagonal %.6g)\n", h.max, h.max * scale,
+              diagonal);
+  std::printf("  A to B                max %.6g, mean %.6g, rms %.6g (%zu samples)\n", h.a_to_b.max, h.a_to_b.mean,
+              h.a_to_b.rms, h.a_to_b.samples);
+  std::printf("  B to A                max %.6g, mean %.6g, rms %.6g (%zu samples)\n", h.b_to_a.max, h.b_to_a.mean,
+              h.b_to_a.rms, h.b_to_a.samples);
+  std::printf("  faces of B flipped    %zu (facing away from the nearest part of A)\n", flipped);
+  return 0;
+}
+
 void print_param(const ParamSpec& p) {
-  std::printf("    %-24s %-5s default %-8s %s\n", flag_of(p.id).c_str(), param_type_name(p.type), p.default_text().c_str(),
-              p.range_text().c_str());
+  std::printf("    %-24s %-5s default %-8s %s\n", flag_of(p.id).c_str(), param_type_name(p.type),
+              p.default_text().c_str(), p.range_text().c_str());
 }
 
 int list() {
@@ -138,8 +205,10 @@ int run(const std::string& id, const std::vector<std::string>& args) {
   WriteOptions options;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
-    if (a == "--json") json = true;
-    else if (a == "--ascii") options.binary = false;
+    if (a == "--json")
+      json = true;
+    else if (a == "--ascii")
+      options.binary = false;
     else if (a.rfind("--", 0) == 0) {
       std::string key = a, value;
       if (auto eq = a.find('='); eq != std::string::npos) {
@@ -157,7 +226,8 @@ int run(const std::string& id, const std::vector<std::string>& args) {
   }
   const std::size_t needed = op.changes_mesh ? 2 : 1;
   if (files.size() != needed && !(files.size() == 2 && !op.changes_mesh))
-    throw Error(op.id + ": needs " + (needed == 2 ? "IN and OUT files" : "an IN file") + "; see 'hedge help " + op.id + "'");
+    throw Error(op.id + ": needs " + (needed == 2 ? "IN and OUT files" : "an IN file") + "; see 'hedge help " + op.id +
+                "'");
   ParamValues params = resolve_params(op, given);  // refuse bad parameters before reading anything
   if (op.changes_mesh) format_from_path(files[1]);
   Soup soup = read_mesh(files[0]);
@@ -180,6 +250,7 @@ int main(int argc, char** argv) {
   try {
     if (command == "info") return info(args);
     if (command == "convert") return convert(args);
+    if (command == "distance") return distance_command(args);
     if (command == "list") return list();
     if (command == "help") return help(args);
     return run(command, args);

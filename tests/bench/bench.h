@@ -3,7 +3,9 @@
 #pragma once
 
 #include <benchmark/benchmark.h>
+#include <time.h>
 
+#include <chrono>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -85,5 +87,78 @@ inline constexpr const char* kNormals = "vertex_normals";
 inline constexpr const char* kNormalsLoop = "vertex_normals_loop";
 inline constexpr const char* kMemory = "memory";
 inline constexpr const char* kMemoryReserved = "memory_reserved";
+
+// ---- the operation table (hedge_bench --ops) ------------------------------------------
+// Whole operations (decimate, remesh, subdivide, smooth), one run each, timed by the
+// library file itself around the library's own call, on a mesh it built from the soup
+// beforehand (not timed). The result comes back as a soup for the error measurements.
+
+//! Wall-clock and process-CPU time of one stretch of code.
+class Stopwatch {
+ public:
+  Stopwatch() { start(); }
+  void start() {
+    wall_ = std::chrono::steady_clock::now();
+    cpu_ = cpu_now();
+  }
+  //! Seconds since start(): wall clock, and CPU time of all the process's threads.
+  void stop(double& wall_s, double& cpu_s) const {
+    wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_).count();
+    cpu_s = cpu_now() - cpu_;
+  }
+
+ private:
+  static double cpu_now() {
+    timespec t{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+  }
+  std::chrono::steady_clock::time_point wall_;
+  double cpu_ = 0;
+};
+
+//! The operations of the table, with the parameters every library is given.
+inline constexpr const char* kOpDecimate = "decimate";  // to 10 % of the input's faces
+inline constexpr const char* kOpRemesh = "remesh";      // isotropic, mean edge length, 3 iterations
+inline constexpr const char* kOpLoop = "loop";          // Loop subdivision, 1 step
+inline constexpr const char* kOpCatmull = "catmull";    // Catmull-Clark subdivision, 1 step
+inline constexpr const char* kOpSmooth = "smooth";      // uniform Laplace, Jacobi, 10 steps of 1/2
+inline constexpr double kDecimateRatio = 0.1;
+inline constexpr int kRemeshIterations = 3;
+inline constexpr int kSmoothIterations = 10;
+
+//! What one run of one operation gave.
+struct OpRun {
+  double wall_s = 0, cpu_s = 0;  //!< the timed part only
+  hedge::Soup output;            //!< the result (for counts and distances; not timed)
+};
+
+//! Builds a library's mesh (not timed), times `op(mesh)`, and converts the result with
+//! `to_soup` (not timed).
+template <class Build, class Op, class ToSoup>
+OpRun time_operation(Build build_mesh, Op op, ToSoup to_soup) {
+  auto mesh = build_mesh();
+  OpRun run;
+  Stopwatch watch;
+  op(*mesh);
+  watch.stop(run.wall_s, run.cpu_s);
+  run.output = to_soup(*mesh);
+  return run;
+}
+
+//! One library's implementation of one operation. `run` times only the call named in
+//! `scope`; the input is the shared soup and, for remesh, the target edge length.
+struct OpEntry {
+  std::string op;
+  std::string scope;  //!< what the time includes, for the table's legend
+  OpRun (*run)(double target_edge_length);
+};
+std::vector<OpEntry> hedge_operations();
+std::vector<OpEntry> openmesh_operations();
+std::vector<OpEntry> cgal_operations();
+
+//! Runs the operation table (and, with `hosts`, MeshLab and Blender as separate processes);
+//! returns the process exit code.
+int run_operation_table(int reps, bool hosts);
 
 }  // namespace bench

@@ -3,7 +3,11 @@
 // faces that would make an edge or vertex non-manifold.
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Polygon_mesh_processing/compute_normal.h>
+#include <CGAL/Polygon_mesh_processing/remesh.h>
+#include <CGAL/Subdivision_method_3/subdivision_methods_3.h>
 #include <CGAL/Surface_mesh.h>
+#include <CGAL/Surface_mesh_simplification/Policies/Edge_collapse/GarlandHeckbert_plane_policies.h>
+#include <CGAL/Surface_mesh_simplification/edge_collapse.h>
 
 #include <cmath>
 #include <memory>
@@ -148,6 +152,85 @@ void memory_of(benchmark::State& state, bool reserve) {
 void memory(benchmark::State& state) { memory_of(state, false); }
 void memory_reserved(benchmark::State& state) { memory_of(state, true); }
 
+// ---- whole operations (--ops) ----------------------------------------------------------
+
+//! The mesh as a soup (live elements only), for the error measurements.
+hedge::Soup to_soup(const SMesh& mesh) {
+  hedge::Soup soup;
+  std::vector<std::uint32_t> index(mesh.num_vertices(), 0);
+  for (VI v : mesh.vertices()) {
+    index[v.idx()] = static_cast<std::uint32_t>(soup.positions.size());
+    const Kernel::Point_3& p = mesh.point(v);
+    soup.positions.push_back({static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())});
+  }
+  for (auto f : mesh.faces()) {
+    std::uint32_t n = 0;
+    for (VI v : vertices_around_face(mesh.halfedge(f), mesh)) {
+      soup.corners.push_back(index[v.idx()]);
+      ++n;
+    }
+    soup.face_sizes.push_back(n);
+  }
+  return soup;
+}
+
+//! Stops edge_collapse when the face count reaches the target (CGAL 5.5's stop predicates
+//! count edges only).
+struct FaceCountStop {
+  const SMesh* mesh;
+  std::size_t target;
+  template <class Cost, class Profile>
+  bool operator()(const Cost&, const Profile&, std::size_t, std::size_t) const {
+    return mesh->number_of_faces() <= target;
+  }
+};
+
+//! Surface_mesh_simplification::edge_collapse with the Garland-Heckbert plane policies
+//! (classic quadrics, CGAL 5.5), to 10 % of the faces.
+OpRun decimate_run(double) {
+  namespace SMS = CGAL::Surface_mesh_simplification;
+  return time_operation(
+      [] { return build_mesh(false); },
+      [&](SMesh& mesh) {
+        {
+          SMS::GarlandHeckbert_plane_policies<SMesh, Kernel> policies(mesh);
+          FaceCountStop stop{&mesh, static_cast<std::size_t>(
+                                        std::llround(kDecimateRatio * static_cast<double>(mesh.number_of_faces())))};
+          SMS::edge_collapse(mesh, stop,
+                             CGAL::parameters::get_cost(policies.get_cost()).get_placement(policies.get_placement()));
+        }
+      },
+      [](const SMesh& mesh) { return to_soup(mesh); });
+}
+
+//! Polygon_mesh_processing::isotropic_remeshing of every face, at the shared target
+//! length, 3 iterations, CGAL's defaults otherwise (1 relaxation step, projection on).
+OpRun remesh_run(double target) {
+  return time_operation([] { return build_mesh(false); },
+                        [&](SMesh& mesh) {
+                          CGAL::Polygon_mesh_processing::isotropic_remeshing(
+                              faces(mesh), target, mesh, CGAL::parameters::number_of_iterations(kRemeshIterations));
+                        },
+                        [](const SMesh& mesh) { return to_soup(mesh); });
+}
+
+OpRun loop_run(double) {
+  return time_operation([] { return build_mesh(false); },
+                        [&](SMesh& mesh) {
+                          CGAL::Subdivision_method_3::Loop_subdivision(mesh, CGAL::parameters::number_of_iterations(1));
+                        },
+                        [](const SMesh& mesh) { return to_soup(mesh); });
+}
+
+OpRun catmull_run(double) {
+  return time_operation([] { return build_mesh(false); },
+                        [&](SMesh& mesh) {
+                          CGAL::Subdivision_method_3::CatmullClark_subdivision(
+                              mesh, CGAL::parameters::number_of_iterations(1));
+                        },
+                        [](const SMesh& mesh) { return to_soup(mesh); });
+}
+
 }  // namespace
 
 std::vector<Entry> cgal_benchmarks() {
@@ -158,6 +241,13 @@ std::vector<Entry> cgal_benchmarks() {
           {kNormalsLoop, normals_loop},
           {kMemory, memory},
           {kMemoryReserved, memory_reserved}};
+}
+
+std::vector<OpEntry> cgal_operations() {
+  return {{kOpDecimate, "SMS::edge_collapse, GarlandHeckbert_plane_policies (policy set-up included)", decimate_run},
+          {kOpRemesh, "PMP::isotropic_remeshing(faces(mesh), L, mesh, number_of_iterations(3))", remesh_run},
+          {kOpLoop, "Subdivision_method_3::Loop_subdivision, 1 step", loop_run},
+          {kOpCatmull, "Subdivision_method_3::CatmullClark_subdivision, 1 step", catmull_run}};
 }
 
 }  // namespace bench

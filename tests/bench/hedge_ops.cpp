@@ -1,11 +1,16 @@
 // hedge's side of hedge_bench: build(), circulators, vertex_normals(), heap.
+#include <cmath>
 #include <memory>
 #include <string>
 
 #include "bench.h"
 #include "hedge/build.h"
+#include "hedge/decimate.h"
 #include "hedge/mesh.h"
 #include "hedge/normals.h"
+#include "hedge/remesh.h"
+#include "hedge/smooth.h"
+#include "hedge/subdivide.h"
 
 namespace bench {
 
@@ -100,7 +105,78 @@ void memory(benchmark::State& state) {
   state.counters["bytes_per_face"] = static_cast<double>(s.live_bytes) / static_cast<double>(s.faces);
 }
 
+// ---- whole operations (--ops) ----------------------------------------------------------
+// Each runs twice in one call: the operation alone on a mesh built beforehand (the same
+// scope as the peers' rows), and build + operation + extract from the soup (what a host
+// pays). OpRun carries the first; the second goes under the library name "hedge+io".
+
+template <class Operation>
+OpRun run_hedge(Operation operation) {
+  return time_operation([] { return std::make_unique<hedge::Mesh>(hedge::build(input().soup).mesh); }, operation,
+                        [](const hedge::Mesh& mesh) { return hedge::extract(mesh); });
+}
+
+template <class Operation>
+OpRun run_hedge_io(Operation operation) {
+  OpRun run;
+  Stopwatch watch;
+  hedge::Mesh mesh = hedge::build(input().soup).mesh;
+  operation(mesh);
+  run.output = hedge::extract(mesh);
+  watch.stop(run.wall_s, run.cpu_s);
+  return run;
+}
+
+void decimate_op(hedge::Mesh& mesh) {
+  hedge::DecimateOptions options;
+  options.target_faces = static_cast<std::size_t>(std::llround(kDecimateRatio * static_cast<double>(mesh.n_faces())));
+  hedge::decimate(mesh, options);
+}
+
+double g_target_length = 0;
+void remesh_op(hedge::Mesh& mesh) {
+  hedge::RemeshOptions options;  // the catalogue's defaults: features at 45 degrees, boundary kept
+  options.target_edge_length = g_target_length;
+  options.iterations = kRemeshIterations;
+  hedge::remesh(mesh, options);
+}
+
+void loop_op(hedge::Mesh& mesh) {
+  hedge::SubdivideOptions options;
+  options.scheme = hedge::SubdivisionScheme::loop;
+  hedge::subdivide(mesh, options);
+}
+
+void catmull_op(hedge::Mesh& mesh) {
+  hedge::SubdivideOptions options;
+  options.scheme = hedge::SubdivisionScheme::catmull_clark;
+  hedge::subdivide(mesh, options);
+}
+
+void smooth_op(hedge::Mesh& mesh) {
+  hedge::SmoothOptions options;  // uniform weights, 1/2 of the way, boundary fixed
+  options.iterations = kSmoothIterations;
+  hedge::smooth(mesh, options);
+}
+
+//! The table's entry point: `with_io` selects build + operation + extract as the timed part.
+template <void (*Op)(hedge::Mesh&), bool with_io>
+OpRun run_op(double target) {
+  g_target_length = target;
+  return with_io ? run_hedge_io(Op) : run_hedge(Op);
+}
+
 }  // namespace
+
+std::vector<OpEntry> hedge_operations() {
+  const std::string alone = "the operation on a built Mesh";
+  const std::string io = "build from the soup + operation + extract to a soup";
+  return {{kOpDecimate, alone, run_op<decimate_op, false>}, {kOpDecimate, io, run_op<decimate_op, true>},
+          {kOpRemesh, alone, run_op<remesh_op, false>},     {kOpRemesh, io, run_op<remesh_op, true>},
+          {kOpLoop, alone, run_op<loop_op, false>},         {kOpLoop, io, run_op<loop_op, true>},
+          {kOpCatmull, alone, run_op<catmull_op, false>},   {kOpCatmull, io, run_op<catmull_op, true>},
+          {kOpSmooth, alone, run_op<smooth_op, false>},     {kOpSmooth, io, run_op<smooth_op, true>}};
+}
 
 std::vector<hedge::Vec3f> hedge_area_normals_by_soup_vertex() {
   if (!cache_slot()) return {};

@@ -251,7 +251,11 @@ void usage() {
       "hedge_bench [--meshes DIR] [--mesh FILE] [--reps N] [benchmark flags]\n"
       "  --meshes DIR   directory of the fetched meshes (default build/meshes)\n"
       "  --mesh FILE    the mesh to use; a bare name is looked up in DIR (default dragon.ply)\n"
-      "  --reps N       repetitions per benchmark; the table shows their minimum (default 10)\n");
+      "  --reps N       repetitions per benchmark; the table shows their minimum (default 10)\n"
+      "  --ops          instead: the table of whole operations (decimate, remesh, subdivide, smooth)\n"
+      "                 against OpenMesh and CGAL in this process (ops.cpp)\n"
+      "  --hosts        with --ops: also MeshLab (meshlabserver) and Blender (blender -b); slow\n"
+      "  --op-reps N    runs per library and operation in the --ops table (default 1)\n");
   benchmark::PrintDefaultHelp();
 }
 
@@ -261,7 +265,8 @@ double min_statistic(const std::vector<double>& v) { return bench::min_of(v); }
 
 int main(int argc, char** argv) {
   std::string dir = "build/meshes", mesh = "dragon.ply";
-  int reps = 10;
+  int reps = 10, op_reps = 1;
+  bool ops = false, hosts = false;
   std::vector<char*> rest = {argv[0]};
   for (int i = 1; i < argc; ++i) {
     std::string a = argv[i];
@@ -280,6 +285,15 @@ int main(int argc, char** argv) {
     if (value("--meshes", dir) || value("--mesh", mesh)) continue;
     if (value("--reps", reps_text)) {
       reps = std::max(1, std::atoi(reps_text.c_str()));
+      continue;
+    }
+    if (a == "--ops" || a == "--hosts") {
+      ops = true;
+      hosts |= a == "--hosts";
+      continue;
+    }
+    if (value("--op-reps", reps_text)) {
+      op_reps = std::max(1, std::atoi(reps_text.c_str()));
       continue;
     }
     if (a == "--help" || a == "-h") {
@@ -326,6 +340,7 @@ int main(int argc, char** argv) {
     return 1;
   }
   std::fflush(stdout);
+  if (ops) return bench::run_operation_table(op_reps, hosts);
 
   bench::CollectingReporter reporter(benchmark::CreateDefaultDisplayReporter());
   benchmark::RunSpecifiedBenchmarks(&reporter);

@@ -3,6 +3,11 @@
 // add_vertex + add_face, which drops the faces that would make an edge or vertex complex.
 #include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
 #include <OpenMesh/Core/System/omstream.hh>
+#include <OpenMesh/Tools/Decimater/DecimaterT.hh>
+#include <OpenMesh/Tools/Decimater/ModQuadricT.hh>
+#include <OpenMesh/Tools/Smoother/JacobiLaplaceSmootherT.hh>
+#include <OpenMesh/Tools/Subdivider/Uniform/LoopT.hh>
+#include <cmath>
 #include <memory>
 #include <vector>
 
@@ -155,6 +160,79 @@ void memory_of(benchmark::State& state, bool reserve) {
 void memory(benchmark::State& state) { memory_of(state, false); }
 void memory_reserved(benchmark::State& state) { memory_of(state, true); }
 
+// ---- whole operations (--ops) ----------------------------------------------------------
+
+//! The mesh as a soup (live elements only), for the error measurements.
+hedge::Soup to_soup(const OMesh& mesh) {
+  hedge::Soup soup;
+  std::vector<std::uint32_t> index(mesh.n_vertices(), 0);
+  for (auto v : mesh.vertices()) {
+    index[static_cast<std::size_t>(v.idx())] = static_cast<std::uint32_t>(soup.positions.size());
+    const OMesh::Point& p = mesh.point(v);
+    soup.positions.push_back({p[0], p[1], p[2]});
+  }
+  for (auto f : mesh.faces()) {
+    std::uint32_t n = 0;
+    for (auto v : mesh.fv_range(f)) {
+      soup.corners.push_back(index[static_cast<std::size_t>(v.idx())]);
+      ++n;
+    }
+    soup.face_sizes.push_back(n);
+  }
+  return soup;
+}
+
+//! Decimater + ModQuadric (no error bound: the quadric only ranks), to 10 % of the faces.
+OpRun decimate_run(double) {
+  return time_operation([] { return build_mesh(false); },
+                        [&](OMesh& mesh) {
+                          {
+                            mesh.request_vertex_status();
+                            mesh.request_edge_status();
+                            mesh.request_face_status();
+                            OpenMesh::Decimater::DecimaterT<OMesh> decimater(mesh);
+                            OpenMesh::Decimater::ModQuadricT<OMesh>::Handle quadric;
+                            decimater.add(quadric);
+                            decimater.module(quadric).unset_max_err();
+                            decimater.initialize();
+                            const auto target = static_cast<std::size_t>(
+                                std::llround(kDecimateRatio * static_cast<double>(mesh.n_faces())));
+                            decimater.decimate_to_faces(0, target);
+                          }
+                          mesh.garbage_collection();
+                        },
+                        [](const OMesh& mesh) { return to_soup(mesh); });
+}
+
+//! Subdivider::Uniform::LoopT, one step.
+OpRun loop_run(double) {
+  return time_operation([] { return build_mesh(false); },
+                        [&](OMesh& mesh) {
+                          {
+                            OpenMesh::Subdivider::Uniform::LoopT<OMesh> loop;
+                            loop.attach(mesh);
+                            loop(1);
+                            loop.detach();
+                          }
+                        },
+                        [](const OMesh& mesh) { return to_soup(mesh); });
+}
+
+//! Smoother::JacobiLaplaceSmootherT: uniform weights, tangential and normal, C0, 10 steps
+//! (each moves a vertex half way to its neighbours' mean; boundary vertices stay).
+OpRun smooth_run(double) {
+  return time_operation([] { return build_mesh(false); },
+                        [&](OMesh& mesh) {
+                          {
+                            OpenMesh::Smoother::JacobiLaplaceSmootherT<OMesh> smoother(mesh);
+                            smoother.initialize(OpenMesh::Smoother::SmootherT<OMesh>::Tangential_and_Normal,
+                                                OpenMesh::Smoother::SmootherT<OMesh>::C0);
+                            smoother.smooth(kSmoothIterations);
+                          }
+                        },
+                        [](const OMesh& mesh) { return to_soup(mesh); });
+}
+
 }  // namespace
 
 std::vector<hedge::Vec3f> openmesh_area_normals_by_soup_vertex() {
@@ -177,6 +255,12 @@ std::vector<Entry> openmesh_benchmarks() {
           {kNormalsLoop, normals_loop},
           {kMemory, memory},
           {kMemoryReserved, memory_reserved}};
+}
+
+std::vector<OpEntry> openmesh_operations() {
+  return {{kOpDecimate, "DecimaterT + ModQuadricT: initialize, decimate_to_faces, garbage_collection", decimate_run},
+          {kOpLoop, "Subdivider::Uniform::LoopT, 1 step", loop_run},
+          {kOpSmooth, "JacobiLaplaceSmootherT: constructor, initialize, smooth(10)", smooth_run}};
 }
 
 }  // namespace bench

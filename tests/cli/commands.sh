@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# The hedge command line on real meshes: info (text and JSON), convert, list, help, the
-# report operation, and clear non-zero exits on bad input.
+# The hedge command line on real meshes: info (text and JSON), convert, list, help, distance,
+# the report operation, and clear non-zero exits on bad input.
 set -euo pipefail
 HEDGE=$1
 MESHES=$2
@@ -47,6 +47,38 @@ head -c 20 "$work/ascii.ply" | grep -q "ply" || fail "ascii ply header"
 
 # report runs without an output file; --json is one object.
 "$HEDGE" report "$bunny" --json | python3 -c 'import json,sys; d=json.load(sys.stdin); assert d["faces"] > 0'
+
+# distance: a mesh is at distance 0 from itself and has no flipped face; a decimated copy is
+# near but not at 0; a copy with every face turned over has them (nearly) all flipped (where
+# the bunny bends sharply, a face also has input turned its way close by: not counted).
+"$HEDGE" distance "$bunny" "$bunny" --json > "$work/same.json"
+"$HEDGE" decimate "$bunny" "$work/small.off" --target-ratio 0.2 > /dev/null
+"$HEDGE" distance "$bunny" "$work/small.off" --json > "$work/small.json"
+python3 - "$bunny" "$work/flipped.off" <<'PY'
+import sys
+lines = open(sys.argv[1]).read().split("\n")
+nv, nf = map(int, lines[1].split()[:2])
+out = lines[:2 + nv]
+for line in lines[2 + nv:2 + nv + nf]:
+    n, *idx = line.split()
+    out.append(" ".join([n] + idx[::-1]))
+open(sys.argv[2], "w").write("\n".join(out) + "\n")
+PY
+"$HEDGE" distance "$bunny" "$work/flipped.off" --json > "$work/flipped.json"
+python3 - "$work/same.json" "$work/small.json" "$work/flipped.json" <<'PY'
+import json, sys
+same, small, flipped = (json.load(open(p)) for p in sys.argv[1:])
+assert same["hausdorff_over_diagonal"] < 1e-9 and same["flipped_faces"] == 0 and same["faces_b"] == 3674, same
+assert 0 < small["hausdorff_over_diagonal"] < 0.02 and abs(small["faces_b"] - 735) <= 1, small
+assert small["a_to_b"]["max"] <= small["hausdorff"] and small["b_to_a"]["max"] <= small["hausdorff"], small
+assert small["flipped_faces"] == 0, small
+assert flipped["hausdorff_over_diagonal"] < 1e-9 and flipped["flipped_faces"] > 0.95 * 3674, flipped
+PY
+"$HEDGE" distance "$bunny" "$work/small.off" | grep -q "symmetric Hausdorff" || fail "distance text output"
+if "$HEDGE" distance "$bunny" 2> "$work/err.txt"; then fail "distance with one file accepted"; fi
+grep -q "two files" "$work/err.txt" || fail "distance message: $(cat "$work/err.txt")"
+if "$HEDGE" distance "$bunny" "$bunny" --samples-per-face x 2> "$work/err.txt"; then fail "bad density accepted"; fi
+grep -q "samples-per-face" "$work/err.txt" || fail "density message: $(cat "$work/err.txt")"
 
 # Bad input: non-zero exit and a message naming the problem; nothing written.
 printf 'OFF\n3 1 0\n0 0 0\n1 0 0\nnan 1 0\n3 0 1 2\n' > "$work/nan.off"

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -120,6 +121,18 @@ Quality measure(const Mesh& input, const Mesh& out, double target, double sample
   options.sample_density = sample_density;
   q.hausdorff = hausdorff(input, out, options).max / mesh_statistics(input).bbox_diagonal;
   return q;
+}
+
+// The share of triangles with an angle under `degrees`.
+double share_thinner(const Mesh& mesh, double degrees) {
+  std::size_t thin = 0;
+  for (Face f : mesh.faces()) {
+    std::array<Vec3d, 3> p;
+    int k = 0;
+    for (Vertex v : mesh.vertices(f)) p[k++] = to_double(mesh.position(v));
+    thin += triangle_min_angle(p[0], p[1], p[2]) < degrees;
+  }
+  return double(thin) / double(mesh.n_faces());
 }
 
 void expect_valid(const Mesh& mesh) {
@@ -425,7 +438,7 @@ TEST(Remesh, CatalogueEntry) {
 // The low resolutions of the dragon are non-manifold with many holes: build() splits them
 // into copies that must stay welded (fixed) and boundaries that stay as they are, so the
 // share of edges in the band is printed there, not asserted.
-void check_real(const char* name, int iterations, bool band) {
+void check_real(const char* name, int iterations, bool band, bool min_angle = false) {
   std::string path = std::string(HEDGE_MESH_DIR) + "/" + name;
   if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " not present";
   Mesh input = mesh_of(read_mesh(path));
@@ -439,13 +452,23 @@ void check_real(const char* name, int iterations, bool band) {
   Quality q = measure(input, mesh, report.target_edge_length);
   MeshStatistics before = mesh_statistics(input);
   std::printf(
-      "[ figures  ] %s: %zu -> %zu faces in %.2f s (%d iterations); in band %.1f%%; mean min angle %.1f -> "
-      "%.1f deg; irregular valence %.1f%% -> %.1f%%; Hausdorff %.4f%% of the diagonal\n",
-      name, input.n_faces(), mesh.n_faces(), seconds, iterations, 100 * q.in_band, before.mean_min_angle_degrees,
-      q.stats.mean_min_angle_degrees, 100 * before.valence_irregular_fraction, 100 * q.stats.valence_irregular_fraction,
-      100 * q.hausdorff);
+      "[ figures  ] %s: %zu -> %zu faces in %.2f s (%d iterations); in band %.1f%%; min angle %.2f -> %.2f deg, "
+      "mean min angle %.1f -> %.1f deg; irregular valence %.1f%% -> %.1f%%; Hausdorff %.4f%% of the diagonal\n",
+      name, input.n_faces(), mesh.n_faces(), seconds, iterations, 100 * q.in_band, before.min_angle_degrees,
+      q.stats.min_angle_degrees, before.mean_min_angle_degrees, q.stats.mean_min_angle_degrees,
+      100 * before.valence_irregular_fraction, 100 * q.stats.valence_irregular_fraction, 100 * q.hausdorff);
   if (band) {
     EXPECT_GE(q.in_band, 0.9);
+  }
+  if (min_angle) {
+    // The scan's own worst triangles lie between vertices remeshing must keep (boundary,
+    // non-manifold copies), so the smallest angle can at best stay; the share of thin
+    // triangles must drop.
+    EXPECT_GE(q.stats.min_angle_degrees, before.min_angle_degrees);
+    const double thin_before = share_thinner(input, 10), thin_after = share_thinner(mesh, 10);
+    std::printf("[ figures  ] %s: triangles with an angle under 10 deg: %.3f%% -> %.3f%%\n", name, 100 * thin_before,
+                100 * thin_after);
+    EXPECT_LT(thin_after, thin_before);
   }
   EXPECT_GT(q.stats.mean_min_angle_degrees, before.mean_min_angle_degrees);
   EXPECT_LT(q.stats.valence_irregular_fraction, before.valence_irregular_fraction);
@@ -454,6 +477,11 @@ void check_real(const char* name, int iterations, bool band) {
 
 TEST(Remesh, Bunny) { check_real("bunny.off", 5, true); }
 TEST(Remesh, DragonRes3NonManifold) { check_real("dragon_res3.ply", 5, false); }
+// The quality gates on a real scan of 202k faces with the catalogue's defaults: at
+// least 90 % of the edges within [0.8, 1.33] x target, a smallest angle no smaller, fewer thin
+// triangles, a larger mean smallest angle, fewer irregular vertices, Hausdorff under 1 % of
+// the diagonal.
+TEST(Remesh, DragonRes2QualityGates) { check_real("dragon_res2.ply", 5, true, true); }
 TEST(Remesh, DragonRes4NonManifold) { check_real("dragon_res4.ply", 5, false); }
 
 // Speed figures (printed, not asserted): 3 iterations at the mean edge length, as the

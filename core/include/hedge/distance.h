@@ -57,6 +57,11 @@ class TriangleTree {
   //! As above, starting from a guess: the distance to triangle `hint` (e.g. the answer for
   //! a nearby point) bounds the search from the start, which makes it much cheaper.
   ClosestPoint closest_point_with_hint(const Vec3d& p, Index hint) const;
+  //! Closest point among the triangles whose normal (right-hand rule over the corners as
+  //! given) has a positive dot product with `direction`; not found() when none is nearer
+  //! than max_distance.
+  ClosestPoint closest_point_facing(const Vec3d& p, const Vec3d& direction,
+                                    double max_distance = std::numeric_limits<double>::infinity()) const;
 
   //! Heap bytes held.
   std::size_t heap_bytes() const;
@@ -74,7 +79,8 @@ class TriangleTree {
     Point a, b, c;
   };
   void build(std::vector<Triangle> triangles, std::vector<Index> original);
-  void search(const Vec3d& p, ClosestPoint& best, double& best_sq) const;
+  //! With `facing`, only triangles whose normal points to its side (positive dot product).
+  void search(const Vec3d& p, ClosestPoint& best, double& best_sq, const Vec3d* facing = nullptr) const;
 
   std::vector<Node> nodes_;
   std::vector<Triangle> triangles_;  //!< in tree (leaf) order
@@ -116,5 +122,13 @@ OneSidedDistance one_sided_distance(const Mesh& from, const TriangleTree& to, co
 //! stratified random points on the faces, both ways). Deterministic for a seed, whatever
 //! the number of threads. Throws Error when either mesh has no faces.
 HausdorffResult hausdorff(const Mesh& a, const Mesh& b, const HausdorffOptions& options = {});
+
+//! Faces of `mesh` turned over against the surface of `reference`: a face counts when, at
+//! three or more of four points inside it (centroid and three points toward its corners), the
+//! nearest reference triangle faces the other way (negative dot product of the normals) and
+//! no reference triangle facing the face's way lies within half the face's longest edge
+//! beyond it (where the reference has two layers that close, a thin part or a sheet seen
+//! from both sides, the nearest triangle says nothing). Degenerate faces are not counted.
+std::size_t flipped_faces(const Mesh& mesh, const TriangleTree& reference);
 
 }  // namespace hedge
