@@ -19,6 +19,15 @@
 namespace hedge {
 namespace {
 
+//! The channel's values of the `kept` elements, in that order.
+void keep_elements(Channel& channel, const std::vector<std::uint32_t>& kept) {
+  const std::size_t stride = channel.stride();
+  std::vector<std::byte> data(kept.size() * stride);
+  for (std::size_t i = 0; i < kept.size(); ++i)
+    std::copy_n(channel.data.begin() + std::ptrdiff_t(kept[i] * stride), stride, data.begin() + std::ptrdiff_t(i * stride));
+  channel.data = std::move(data);
+}
+
 std::string plural(std::size_t n, const char* one, const char* many) {
   return std::to_string(n) + " " + (n == 1 ? one : many);
 }
@@ -169,13 +178,7 @@ void keep_faces(Soup& soup, const std::vector<char>& keep) {
   }
   for (Channel& channel : soup.channels) {
     if (channel.domain == Domain::vertex) continue;
-    const auto& kept = channel.domain == Domain::face ? kept_faces : kept_corners;
-    const std::size_t stride = channel.stride();
-    std::vector<std::byte> data(kept.size() * stride);
-    for (std::size_t i = 0; i < kept.size(); ++i)
-      std::copy_n(channel.data.begin() + std::ptrdiff_t(kept[i] * stride), stride,
-                  data.begin() + std::ptrdiff_t(i * stride));
-    channel.data = std::move(data);
+    keep_elements(channel, channel.domain == Domain::face ? kept_faces : kept_corners);
   }
   soup.face_sizes = std::move(sizes);
   soup.corners = std::move(corners);
@@ -300,15 +303,8 @@ std::size_t weld(Soup& soup, double distance) {
   std::vector<Point> positions(kept.size());
   for (std::size_t i = 0; i < kept.size(); ++i) positions[i] = soup.positions[kept[i]];
   soup.positions = std::move(positions);
-  for (Channel& channel : soup.channels) {
-    if (channel.domain != Domain::vertex) continue;
-    const std::size_t stride = channel.stride();
-    std::vector<std::byte> data(kept.size() * stride);
-    for (std::size_t i = 0; i < kept.size(); ++i)
-      std::copy_n(channel.data.begin() + std::ptrdiff_t(kept[i] * stride), stride,
-                  data.begin() + std::ptrdiff_t(i * stride));
-    channel.data = std::move(data);
-  }
+  for (Channel& channel : soup.channels)
+    if (channel.domain == Domain::vertex) keep_elements(channel, kept);
   return n - kept.size();
 }
 
