@@ -371,11 +371,11 @@ void print_table(const std::vector<Row>& rows, const std::string& mesh_name, con
   std::printf(
       "| library | edges in [0.8, 1.33] L | min angle | mean min angle | irregular valence | Hausdorff / diag |\n");
   std::printf("|---|---:|---:|---:|---:|---:|\n");
-  std::printf("| input | - | %.2f | %.2f | %.1f%% | - |\n", ref.stats.min_angle_degrees,
+  std::printf("| input | - | %.3g | %.2f | %.1f%% | - |\n", ref.stats.min_angle_degrees,
               ref.stats.mean_min_angle_degrees, 100 * ref.stats.valence_irregular_fraction);
   for (const Row& r : rows) {
     if (r.op != kOpRemesh || !r.has_stats || r.library == "hedge+io") continue;
-    std::printf("| %s | %.1f%% | %.2f | %.2f | %.1f%% | %.5f |\n", r.library.c_str(), 100 * r.in_band,
+    std::printf("| %s | %.1f%% | %.3g | %.2f | %.1f%% | %.5f |\n", r.library.c_str(), 100 * r.in_band,
                 r.stats.min_angle_degrees, r.stats.mean_min_angle_degrees, 100 * r.stats.valence_irregular_fraction,
                 r.hausdorff);
   }
