@@ -537,6 +537,11 @@ void Mesh::collapse_unchecked(Halfedge h) {
   Vertex v0 = to_vertex(o), v1 = to_vertex(h);
   Halfedge hn = next(h), hp = prev(h), on = next(o), op = prev(o);
   Face fh = face(h), fo = face(o);
+  // Only a vertex on the boundary has an outgoing boundary half-edge to restore, and a legal
+  // collapse changes no vertex's boundary status but v1's (it becomes v0's or v1's). So away
+  // from the boundary (most collapses) the walks around v1 and the far corners are skipped.
+  const Vertex vl = to_vertex(hn), vr = to_vertex(on);
+  const bool near_boundary = is_boundary(v0) || is_boundary(v1) || is_boundary(vl) || is_boundary(vr);
 
   // After the edge goes, hp is fh's corner at v1: it continues h's corner there.
   hprops_.copy_element(h.idx(), hp.idx());
@@ -563,14 +568,14 @@ void Mesh::collapse_unchecked(Halfedge h) {
     if (outer.is_valid() && halfedge(outer) == og) set_halfedge(outer, k);
     if (halfedge(a) == og) set_halfedge(a, k);
     if (halfedge(b) == g) set_halfedge(b, ok);
-    adjust_outgoing_halfedge(b);
+    if (near_boundary || (b != v1 && b != vl && b != vr)) adjust_outgoing_halfedge(b);
     if (loop_face.is_valid()) mark_deleted(loop_face);
     mark_deleted(edge(g));
   };
   if (next(next(hp)) == hp) remove_loop(hp);
   // The first removal may have deleted on's edge (when fo also held hp's outer side).
   if (!is_deleted(on) && next(next(on)) == on) remove_loop(on);
-  adjust_outgoing_halfedge(v1);
+  if (near_boundary) adjust_outgoing_halfedge(v1);
 }
 
 // ---- triangulation ---------------------------------------------------------------------------

@@ -1,7 +1,10 @@
 // Soup helpers and the validity check every front end relies on.
 #include "hedge/soup.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <string>
 
 #include "hedge/error.h"
@@ -76,17 +79,31 @@ void Soup::check() const {
   if (total != corners.size())
     throw Error("soup: face sizes add up to " + std::to_string(total) + " corners but there are " +
                 std::to_string(corners.size()));
-  for (std::size_t v = 0; v < positions.size(); ++v)
-    for (int k = 0; k < 3; ++k)
-      if (!std::isfinite(positions[v][k]))
-        throw Error("soup: vertex " + std::to_string(v) + " has a " + (std::isnan(positions[v][k]) ? "NaN" : "infinite") +
-                    " coordinate");
-  std::size_t corner = 0;
-  for (std::size_t f = 0; f < face_sizes.size(); ++f)
-    for (std::uint32_t k = 0; k < face_sizes[f]; ++k, ++corner)
-      if (corners[corner] >= positions.size())
-        throw Error("soup: face " + std::to_string(f) + " uses vertex " + std::to_string(corners[corner]) + " but there are only " +
-                    std::to_string(positions.size()) + " vertices");
+  // Branch-free scans first (build() runs this on every soup); the loops that name the
+  // culprit run only when something is wrong.
+  bool finite = true;
+  for (const Point& p : positions)
+    for (int k = 0; k < 3; ++k) {
+      std::uint32_t bits;
+      std::memcpy(&bits, &p[k], sizeof bits);
+      finite &= (bits & 0x7f800000u) != 0x7f800000u;  // exponent all ones: NaN or infinity
+    }
+  if (!finite)
+    for (std::size_t v = 0; v < positions.size(); ++v)
+      for (int k = 0; k < 3; ++k)
+        if (!std::isfinite(positions[v][k]))
+          throw Error("soup: vertex " + std::to_string(v) + " has a " +
+                      (std::isnan(positions[v][k]) ? "NaN" : "infinite") + " coordinate");
+  std::uint32_t largest = 0;
+  for (std::uint32_t c : corners) largest = std::max(largest, c);
+  if (!corners.empty() && largest >= positions.size()) {
+    std::size_t corner = 0;
+    for (std::size_t f = 0; f < face_sizes.size(); ++f)
+      for (std::uint32_t k = 0; k < face_sizes[f]; ++k, ++corner)
+        if (corners[corner] >= positions.size())
+          throw Error("soup: face " + std::to_string(f) + " uses vertex " + std::to_string(corners[corner]) +
+                      " but there are only " + std::to_string(positions.size()) + " vertices");
+  }
   for (const auto& c : channels) {
     if (c.components < 1 || c.stride() == 0)
       throw Error("soup: channel '" + c.name + "' has " + std::to_string(c.components) + " components");
