@@ -123,6 +123,8 @@ class Remesher {
   void split_long_edges();
   void collapse_short_edges();
   void equalize_valences();
+  bool open_cap(Edge e);
+  void open_caps();
   void smooth_and_project();
   void resample_attributes();
 
@@ -581,6 +583,57 @@ void Remesher::equalize_valences() {
   }
 }
 
+// The last smoothing and projection can leave caps: a vertex pushed onto (or near) the
+// edge opposite it, an angle near 180 degrees. Flipping that edge, where the surface allows
+// it, opens them: the flip must raise the smallest angle of the two triangles.
+bool Remesher::open_cap(Edge e) {
+  const Index i = e.idx();
+  if (mesh_.is_deleted(e) || (edge_flags_[i] & kFeature) || mesh_.is_boundary(e)) return false;
+  Halfedge h0 = Mesh::halfedge(e, 0), h1 = Mesh::halfedge(e, 1);
+  Vertex a = mesh_.to_vertex(h0), b = mesh_.to_vertex(h1);
+  Vertex c = mesh_.to_vertex(mesh_.next(h0)), d = mesh_.to_vertex(mesh_.next(h1));
+  Vec3d pa = to_double(mesh_.position(a)), pb = to_double(mesh_.position(b));
+  Vec3d pc = to_double(mesh_.position(c)), pd = to_double(mesh_.position(d));
+  constexpr double kCapCos = -0.8660254037844386;  // cos 150 degrees
+  auto cos_at = [](const Vec3d& apex, const Vec3d& p, const Vec3d& q) {
+    const double l = norm(p - apex) * norm(q - apex);
+    return l > 0 ? dot(p - apex, q - apex) / l : -1.0;
+  };
+  if (!(cos_at(pc, pa, pb) < kCapCos || cos_at(pd, pa, pb) < kCapCos)) return false;
+  Vec3d old_normal = cross(pa - pb, pc - pb) + cross(pb - pa, pd - pa);
+  Vec3d n1 = cross(pc - pa, pd - pa), n2 = cross(pb - pc, pd - pc);
+  if (!(dot(n1, n2) > 0 && dot(n1, old_normal) > 0 && dot(n2, old_normal) > 0)) return false;
+  const double before = std::min(triangle_min_angle(pb, pa, pc), triangle_min_angle(pa, pb, pd));
+  const double after = std::min(triangle_min_angle(pa, pc, pd), triangle_min_angle(pc, pb, pd));
+  if (!(after > before) || !mesh_.is_flip_ok(e)) return false;
+  mesh_.flip(e);
+  --degree_[a.idx()].valence, --degree_[b.idx()].valence, ++degree_[c.idx()].valence, ++degree_[d.idx()].valence;
+  ++report_.flips;
+  return true;
+}
+
+void Remesher::open_caps() {
+  std::vector<Edge>& pending = work_;
+  pending.clear();
+  auto push_quad = [&](Edge e) {
+    for (unsigned side = 0; side < 2; ++side) {
+      Halfedge h = Mesh::halfedge(e, side);
+      pending.push_back(Mesh::edge(mesh_.next(h)));
+      pending.push_back(Mesh::edge(mesh_.prev(h)));
+    }
+  };
+  // Every flip raises the smallest angle of its pair; the budget only guards the loop.
+  std::size_t budget = mesh_.edges_size();
+  for (Index i = 0; i < mesh_.edges_size() && budget; ++i) {
+    if (open_cap(Edge(i))) push_quad(Edge(i)), --budget;
+    while (!pending.empty() && budget) {
+      Edge e = pending.back();
+      pending.pop_back();
+      if (open_cap(e)) push_quad(e), --budget;
+    }
+  }
+}
+
 void Remesher::smooth_and_project() {
   const std::size_t nv = mesh_.vertices_size();
   scratch_.resize(nv);
@@ -799,6 +852,7 @@ RemeshReport Remesher::run() {
     progress_.update(at(3), "smoothing" + round);
     smooth_and_project();
   }
+  open_caps();
   progress_.update(0.98, "carrying attributes");
   resample_attributes();
   mesh_.garbage_collect();
