@@ -538,10 +538,10 @@ void Mesh::collapse_unchecked(Halfedge h) {
   Halfedge hn = next(h), hp = prev(h), on = next(o), op = prev(o);
   Face fh = face(h), fo = face(o);
   // Only a vertex on the boundary has an outgoing boundary half-edge to restore, and a legal
-  // collapse changes no vertex's boundary status but v1's (it becomes v0's or v1's). So away
-  // from the boundary (most collapses) the walks around v1 and the far corners are skipped.
-  const Vertex vl = to_vertex(hn), vr = to_vertex(on);
-  const bool near_boundary = is_boundary(v0) || is_boundary(v1) || is_boundary(vl) || is_boundary(vr);
+  // collapse changes no vertex's boundary status but v1's (it becomes v0's or v1's). So the
+  // walk around v1 is needed only when that is a boundary vertex, and the walk around a
+  // loop's far corner only when its outgoing half-edge was the one removed.
+  const bool boundary_kept = is_boundary(v0) || is_boundary(v1);
 
   // After the edge goes, hp is fh's corner at v1: it continues h's corner there.
   hprops_.copy_element(h.idx(), hp.idx());
@@ -567,15 +567,17 @@ void Mesh::collapse_unchecked(Halfedge h) {
     set_face(k, outer);
     if (outer.is_valid() && halfedge(outer) == og) set_halfedge(outer, k);
     if (halfedge(a) == og) set_halfedge(a, k);
-    if (halfedge(b) == g) set_halfedge(b, ok);
-    if (near_boundary || (b != v1 && b != vl && b != vr)) adjust_outgoing_halfedge(b);
+    if (halfedge(b) == g) {
+      set_halfedge(b, ok);
+      adjust_outgoing_halfedge(b);
+    }
     if (loop_face.is_valid()) mark_deleted(loop_face);
     mark_deleted(edge(g));
   };
   if (next(next(hp)) == hp) remove_loop(hp);
   // The first removal may have deleted on's edge (when fo also held hp's outer side).
   if (!is_deleted(on) && next(next(on)) == on) remove_loop(on);
-  if (near_boundary) adjust_outgoing_halfedge(v1);
+  if (boundary_kept) adjust_outgoing_halfedge(v1);
 }
 
 // ---- triangulation ---------------------------------------------------------------------------

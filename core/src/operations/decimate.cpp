@@ -14,6 +14,7 @@
 #include "hedge/distance.h"
 #include "hedge/error.h"
 #include "hedge/report.h"
+#include "parallel.h"
 #ifdef HEDGE_DECIMATE_DEBUG
 #include <cstdio>
 
@@ -572,13 +573,21 @@ bool Decimator::evaluate(Edge e, Candidate& c) const {
 void Decimator::fill_heap() {
   version_.assign(m_.edges_size(), 0);
   queue_.clear();
-  std::size_t done = 0;
-  const double total = double(std::max<std::size_t>(1, m_.n_edges()));
-  for (Edge e : m_.edges()) {
-    Candidate c;
-    if (evaluate(e, c)) queue_.push(EdgeQueue::key(c.cost, 0), e.idx());
-    if ((++done & 0xffff) == 0) progress_.update(0.1 * done / total, "measuring edges");
-  }
+  // Every edge is measured on all threads (evaluate() only reads), then queued in edge
+  // order, so the queue does not depend on the thread count.
+  const std::size_t n = m_.edges_size();
+  constexpr std::uint32_t kNone = 0xffffffffu;  // above every key of a finite cost
+  std::vector<std::uint32_t> keys(n);
+  parallel_for(n, opt_.threads, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      const Edge e(static_cast<Index>(i));
+      Candidate c;
+      keys[i] = !m_.is_deleted(e) && evaluate(e, c) ? EdgeQueue::key(c.cost, 0) : kNone;
+    }
+  });
+  progress_.update(0.1, "measuring edges");
+  for (std::size_t i = 0; i < n; ++i)
+    if (keys[i] != kNone) queue_.push(keys[i], static_cast<Index>(i));
 }
 
 // Rotation limit and degeneracy of one triangle (apex, a, b) when its apex moves.
