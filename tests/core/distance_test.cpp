@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -263,4 +264,44 @@ TEST(Distance, RealMeshFigures) {
 }
 
 }  // namespace
+namespace {
+
+// Every face with its corners in reverse order (its normal turned over).
+Soup reversed(Soup s) {
+  const auto offsets = s.face_offsets();
+  for (std::size_t f = 0; f < s.n_faces(); ++f)
+    std::reverse(s.corners.begin() + std::ptrdiff_t(offsets[f]), s.corners.begin() + std::ptrdiff_t(offsets[f + 1]));
+  return s;
+}
+
+// Two grids as one soup.
+Soup two_layers(const Soup& a, const Soup& b) {
+  Soup s = a;
+  const auto n = std::uint32_t(s.positions.size());
+  s.positions.insert(s.positions.end(), b.positions.begin(), b.positions.end());
+  s.face_sizes.insert(s.face_sizes.end(), b.face_sizes.begin(), b.face_sizes.end());
+  for (std::uint32_t c : b.corners) s.corners.push_back(c + n);
+  return s;
+}
+
+}  // namespace
+
+TEST(Distance, FlippedFaces) {
+  const Mesh sphere = mesh_of(sphere_soup(12, 16, 1.0, Vec3d{{0, 0, 0}}));
+  EXPECT_EQ(flipped_faces(sphere, TriangleTree(sphere)), 0u);
+  const Mesh inside_out = mesh_of(reversed(sphere_soup(12, 16, 1.0, Vec3d{{0, 0, 0}})));
+  EXPECT_EQ(flipped_faces(inside_out, TriangleTree(sphere)), inside_out.n_faces());
+
+  // A face-down grid just above a face-up one is turned over against it...
+  const Mesh below = mesh_of(grid_soup(10, 1.0, 0.0));
+  const Mesh down = mesh_of(reversed(grid_soup(10, 1.0, 0.004)));
+  EXPECT_EQ(flipped_faces(down, TriangleTree(below)), down.n_faces());
+  // ...unless the reference has a face-down layer close by (a thin sheet seen from both
+  // sides): the nearest triangle is ambiguous there.
+  const Mesh sheet = mesh_of(two_layers(grid_soup(10, 1.0, 0.0), reversed(grid_soup(10, 1.0, 0.01))));
+  EXPECT_EQ(flipped_faces(down, TriangleTree(sheet)), 0u);
+  const Mesh far_apart = mesh_of(two_layers(grid_soup(10, 1.0, 0.0), reversed(grid_soup(10, 1.0, 0.5))));
+  EXPECT_EQ(flipped_faces(down, TriangleTree(far_apart)), down.n_faces());
+}
+
 }  // namespace hedge
