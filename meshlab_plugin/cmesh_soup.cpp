@@ -16,6 +16,8 @@
 #include <unordered_map>
 #include <vector>
 
+#include "hedge/error.h"
+
 namespace hedge::meshlab {
 namespace {
 
@@ -247,11 +249,20 @@ Soup soup_from_mesh(const MeshModel& model) {
     soup.positions[i] = Point{{p[0], p[1], p[2]}};
   }
 
-  // A face pointing at a deleted or foreign vertex is a broken mesh; it has no corners to give.
+  // A face pointing at a deleted or foreign vertex is a broken mesh: refused, as the core
+  // refuses an index out of range (MeshLab 2020.09's OFF and PLY readers keep such faces,
+  // pointing past the end of the vertex array).
   auto vertex_of = [&](const CFaceO& f, int j) -> std::uint32_t {
     const CVertexO* v = f.cV(j);
-    if (v == nullptr || v < &m.vert.front() || v > &m.vert.back()) return kNoIndex;
-    return vertex_index[static_cast<std::size_t>(v - &m.vert.front())];
+    const std::size_t face = static_cast<std::size_t>(&f - &m.face.front());
+    if (v == nullptr) throw Error("face " + std::to_string(face) + " has no vertex " + std::to_string(j));
+    const std::ptrdiff_t index = v - m.vert.data();
+    if (index < 0 || static_cast<std::size_t>(index) >= m.vert.size())
+      throw Error("face " + std::to_string(face) + " uses vertex " + std::to_string(index) + " but there are only " +
+                  std::to_string(m.vert.size()) + " vertices (an index out of range in the file)");
+    if (vertex_index[static_cast<std::size_t>(index)] == kNoIndex)
+      throw Error("face " + std::to_string(face) + " uses vertex " + std::to_string(index) + ", which is deleted");
+    return vertex_index[static_cast<std::size_t>(index)];
   };
   std::vector<std::size_t> triangles;
   std::vector<std::uint32_t> triangle_vertices;  // 3 soup vertices per triangle
@@ -261,7 +272,6 @@ Soup soup_from_mesh(const MeshModel& model) {
     const CFaceO& f = m.face[i];
     if (f.IsD()) continue;
     const std::uint32_t a = vertex_of(f, 0), b = vertex_of(f, 1), c = vertex_of(f, 2);
-    if (a == kNoIndex || b == kNoIndex || c == kNoIndex) continue;
     triangles.push_back(i);
     triangle_vertices.insert(triangle_vertices.end(), {a, b, c});
   }

@@ -163,6 +163,36 @@ const std::vector<Operation>& catalogue() {
   return operations;
 }
 
+std::string catalogue_json() {
+  std::string out = "{\"operations\": [";
+  bool first_op = true;
+  for (const Operation& op : catalogue()) {
+    out += std::string(first_op ? "" : ",") + "\n {\"id\": " + json_string(op.id) +
+           ", \"title\": " + json_string(op.title) + ", \"category\": " + json_string(op.category) +
+           ", \"changes_mesh\": " + (op.changes_mesh ? "true" : "false") + ", \"help\": " + json_string(op.help) +
+           ", \"params\": [";
+    first_op = false;
+    for (std::size_t i = 0; i < op.params.size(); ++i) {
+      const ParamSpec& p = op.params[i];
+      Value def = p.type == ParamType::boolean   ? Value(p.default_value != 0)
+                  : p.type == ParamType::integer ? Value(static_cast<std::int64_t>(p.default_value))
+                  : p.type == ParamType::real    ? Value(p.default_value)
+                                                 : Value(p.default_text());
+      out += std::string(i ? "," : "") + "\n  {\"id\": " + json_string(p.id) + ", \"label\": " + json_string(p.label) +
+             ", \"type\": " + json_string(param_type_name(p.type)) + ", \"default\": " + json_value(def);
+      if (p.type == ParamType::integer)
+        out += ", \"min\": " + json_value(static_cast<std::int64_t>(p.min)) +
+               ", \"max\": " + json_value(static_cast<std::int64_t>(p.max));
+      if (p.type == ParamType::real) out += ", \"min\": " + json_value(p.min) + ", \"max\": " + json_value(p.max);
+      out += ", \"choices\": [";
+      for (std::size_t k = 0; k < p.choices.size(); ++k) out += (k ? ", " : "") + json_string(p.choices[k]);
+      out += "], \"range_text\": " + json_string(p.range_text()) + ", \"help\": " + json_string(p.help) + "}";
+    }
+    out += "]}";
+  }
+  return out + "\n]}\n";
+}
+
 const Operation& find_operation(const std::string& id) {
   for (const auto& op : catalogue())
     if (op.id == id) return op;

@@ -92,8 +92,10 @@ void Soup::check() const {
     for (std::size_t v = 0; v < positions.size(); ++v)
       for (int k = 0; k < 3; ++k)
         if (!std::isfinite(positions[v][k]))
-          throw Error("soup: vertex " + std::to_string(v) + " has a " +
-                      (std::isnan(positions[v][k]) ? "NaN" : "infinite") + " coordinate");
+          throw Error("soup: vertex " + std::to_string(v) + " has " +
+                      (std::isnan(positions[v][k]) ? "a NaN" : "an infinite") + " coordinate (" + "xyz"[k] + " = " +
+                      (std::isnan(positions[v][k]) ? "nan" : positions[v][k] > 0 ? "inf" : "-inf") +
+                      "); every coordinate must be a finite number");
   std::uint32_t largest = 0;
   for (std::uint32_t c : corners) largest = std::max(largest, c);
   if (!corners.empty() && largest >= positions.size()) {

@@ -27,7 +27,7 @@ constexpr const char* kUsage =
     "  hedge distance A B [--json] [--samples-per-face N]\n"
     "                                    symmetric Hausdorff distance between two meshes (sampled),\n"
     "                                    and the faces of B turned over against A\n"
-    "  hedge list                        every operation with its parameters\n"
+    "  hedge list [--json]               every operation with its parameters\n"
     "  hedge help OP                     one operation in full\n"
     "  hedge OP IN [OUT] [--param value ...] [--json] [--ascii]\n"
     "                                    run an operation (OUT not needed for report)\n";
@@ -176,7 +176,13 @@ void print_param(const ParamSpec& p) {
               p.default_text().c_str(), p.range_text().c_str());
 }
 
-int list() {
+int list(const std::vector<std::string>& args) {
+  for (const auto& a : args)
+    if (a != "--json") throw Error("list: unknown option " + a);
+  if (!args.empty()) {
+    std::fputs(catalogue_json().c_str(), stdout);
+    return 0;
+  }
   for (const auto& op : catalogue()) {
     std::printf("%-14s %s (%s)\n", op.id.c_str(), op.title.c_str(), op.category.c_str());
     for (const auto& p : op.params) print_param(p);
@@ -251,7 +257,7 @@ int main(int argc, char** argv) {
     if (command == "info") return info(args);
     if (command == "convert") return convert(args);
     if (command == "distance") return distance_command(args);
-    if (command == "list") return list();
+    if (command == "list") return list(args);
     if (command == "help") return help(args);
     return run(command, args);
   } catch (const std::exception& e) {

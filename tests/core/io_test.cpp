@@ -303,7 +303,9 @@ TEST(IoOff, Errors) {
               HasSubstr("bad.off: line 7: expected the end of the file after 1 face, found '3'"));
   // Topology is not the reader's business, but it reports what Soup::check() finds.
   EXPECT_THAT(err("OFF\n3 1 0\n0 0 0\n0 0 0\n0 0 0\n3 0 1 9\n"), HasSubstr("bad.off: soup: face 0 uses vertex 9"));
-  EXPECT_THAT(err("OFF\n1 0 0\nnan 0 0\n"), HasSubstr("bad.off: soup: vertex 0 has a NaN coordinate"));
+  EXPECT_THAT(err("OFF\n1 0 0\nnan 0 0\n"), HasSubstr("bad.off: soup: vertex 0 has a NaN coordinate (x = nan)"));
+  EXPECT_THAT(err("OFF\n2 0 0\n0 0 0\n0 1 -inf\n"),
+              HasSubstr("bad.off: soup: vertex 1 has an infinite coordinate (z = -inf)"));
   // A header claiming billions of elements in a tiny file is refused before allocating.
   EXPECT_THAT(err("OFF\n4000000000 4000000000 0\n0 0 0\n"),
               HasSubstr("bad.off: line 2: the header declares 4000000000 vertices and 4000000000 faces"));

@@ -2,6 +2,7 @@
 // boundaries, attributes, determinism, failure behaviour; figures on the real meshes.
 #include "hedge/remesh.h"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <array>
@@ -412,6 +413,69 @@ TEST(Remesh, FailureLeavesTheMeshUntouched) {
   EXPECT_EQ(mesh.positions(), input.positions());
   EXPECT_TRUE(validate(mesh).ok);
   EXPECT_FALSE(mesh.is_triangle_mesh());
+}
+
+// One polygon of 100,000 corners on a circle: its mean edge length on its own disc would make
+// billions of triangles. Refused at once, naming the parameter, the mesh untouched; a sensible
+// target still works.
+TEST(Remesh, RefusesTargetsThatWouldMakeTooManyTriangles) {
+  Soup soup;
+  const int n = 100000;
+  std::vector<std::uint32_t> corners;
+  for (int k = 0; k < n; ++k) {
+    const double a = 2 * std::numbers::pi * k / n;
+    soup.positions.push_back(Point{{float(std::cos(a)), float(std::sin(a)), 0}});
+    corners.push_back(std::uint32_t(k));
+  }
+  soup.add_face(corners);
+  Mesh mesh = mesh_of(soup);
+  const Mesh input = mesh;
+  try {
+    remesh(mesh, RemeshOptions{});
+    FAIL() << "accepted";
+  } catch (const Error& e) {
+    EXPECT_THAT(e.what(), testing::HasSubstr("(the mean edge length of the input)"));
+    EXPECT_THAT(e.what(), testing::HasSubstr("more than the limit of 200000000; give a larger target_edge_length"));
+  }
+  EXPECT_EQ(mesh.n_faces(), 1u);
+  EXPECT_EQ(mesh.positions(), input.positions());
+
+  Mesh cube = mesh_of(cube_soup(2));  // area 24
+  RemeshOptions options;
+  options.target_edge_length = 0.1;  // about 5,500 triangles
+  options.max_faces = 5000;
+  EXPECT_THROW(remesh(cube, options), Error);
+  options.max_faces = 6000;
+  options.iterations = 1;
+  EXPECT_NO_THROW(remesh(cube, options));
+  EXPECT_TRUE(validate(cube).ok);
+}
+
+// A coarse mesh far above the target (an octahedron of edge 1.4, target 0.05): the split pass
+// refines in even rounds, so the result stays near area / (sqrt(3)/4 L^2) = 6,400 triangles
+// (splitting each edge to the end at once, fans to the far corners made 390,000 triangles in
+// the first iteration and 8,300 after five).
+TEST(Remesh, CoarseInputRefinesEvenly) {
+  Soup soup;
+  for (Point p :
+       {Point{{1, 0, 0}}, Point{{-1, 0, 0}}, Point{{0, 1, 0}}, Point{{0, -1, 0}}, Point{{0, 0, 1}}, Point{{0, 0, -1}}})
+    soup.positions.push_back(p);
+  for (auto f : std::vector<std::vector<std::uint32_t>>{
+           {0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}})
+    soup.add_face(f);
+  Mesh mesh = mesh_of(soup);
+  RemeshOptions options;
+  options.target_edge_length = 0.05;
+  options.iterations = 1;
+  const RemeshReport first = remesh(mesh, options);
+  EXPECT_LT(first.splits, 30000u);
+  EXPECT_LT(mesh.n_faces(), 20000u);
+  mesh = mesh_of(soup);
+  options.iterations = 5;
+  remesh(mesh, options);
+  EXPECT_TRUE(validate(mesh).ok);
+  EXPECT_GT(mesh.n_faces(), 5000u);
+  EXPECT_LT(mesh.n_faces(), 8000u);
 }
 
 TEST(Remesh, CatalogueEntry) {

@@ -255,6 +255,24 @@ TEST_F(PluginTest, DeletedElementsAreSkippedAndTheResultIsCompact) {
   for (const CFaceO& f : m.face) EXPECT_FALSE(f.IsD());
 }
 
+// A face on a deleted vertex is a broken mesh (MeshLab's readers also leave faces pointing past
+// the vertex array on indices out of range): refused naming the face, never silently dropped.
+TEST_F(PluginTest, FaceOnADeletedVertexIsRefused) {
+  Document doc(mesh_path("bunny.off"));
+  CMeshO& m = doc.model->cm;
+  CVertexO* v = m.face[7].V(2);
+  vcg::tri::Allocator<CMeshO>::DeleteVertex(m, *v);
+  const Snapshot before = snapshot(*doc.model);
+  EXPECT_FALSE(doc.apply("smooth"));
+  // The first face on that vertex is named (face 7 or one before it around the vertex).
+  const std::string expected = " uses vertex " + std::to_string(v - m.vert.data()) + ", which is deleted";
+  const std::string message = hedge_plugin->errorMsg().toStdString();
+  EXPECT_EQ(message.rfind("face ", 0), 0u) << message;
+  EXPECT_NE(message.find(expected), std::string::npos) << message;
+  EXPECT_NE(doc.log_text().find("Hedge: Smooth failed: " + message), std::string::npos) << doc.log_text();
+  EXPECT_TRUE(snapshot(*doc.model) == before);
+}
+
 TEST_F(PluginTest, CustomAttributesAreCarried) {
   Document doc(mesh_path("bunny.off"));
   CMeshO& m = doc.model->cm;

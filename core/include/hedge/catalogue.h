@@ -87,6 +87,10 @@ struct Operation {
 const std::vector<Operation>& catalogue();
 //! Throws Error listing the known ids when there is no such operation.
 const Operation& find_operation(const std::string& id);
+//! Every operation and its parameters as one JSON object {"operations": [...]}, for scripts
+//! (`hedge list --json`): ids, titles, categories, help, and per parameter its type, default,
+//! limits (integer and real), choices and range text.
+std::string catalogue_json();
 
 //! Turns text values (CLI, scripts) into checked values; parameters not given take their
 //! defaults. Unknown ids, wrong types and out-of-range values throw Error naming the

@@ -25,6 +25,9 @@ struct RemeshOptions {
   //! Edge length follows curvature: shorter where the surface bends (down to a quarter of
   //! the target), longer where it is flat (up to twice the target).
   bool adaptive = false;
+  //! Refuse (before starting) a target length that would make more triangles than this on
+  //! the input's area (about area / (sqrt(3)/4 L^2), as equilateral triangles of side L).
+  std::size_t max_faces = 200'000'000;
 };
 
 struct RemeshReport {
@@ -43,7 +46,8 @@ struct RemeshReport {
 //! input surface. Polygons are triangulated first. Attributes are carried: vertex, corner
 //! and face channels are interpolated on splits, corners are continued on flips and
 //! collapses, and vertex channels of moved vertices are resampled on the input surface.
-//! Throws Error on bad options (and Cancelled when progress asks), leaving the mesh as it was.
+//! Throws Error on bad options and on targets forecast above options.max_faces (and
+//! Cancelled when progress asks), leaving the mesh as it was.
 RemeshReport remesh(Mesh& mesh, const RemeshOptions& options, Progress& progress = Progress::none());
 
 Operation remesh_operation();

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <exception>
 #include <numbers>
@@ -42,6 +43,34 @@ constexpr double kFlipMinAngleDegrees = 10;
 // Adaptive sizing: the chord error allowed per target length, and the bounds of the sizes.
 constexpr double kAdaptiveTolerance = 0.05;
 constexpr double kAdaptiveMin = 0.25, kAdaptiveMax = 2.0;
+
+// Rounds of the split pass per iteration (each halves the edges still too long); edges longer
+// than 2^kMaxSplitRounds times the target wait for the next iteration.
+constexpr int kMaxSplitRounds = 16;
+
+// No collapse merges two vertices whose valences add up to more than this (see may_collapse).
+constexpr std::int32_t kMaxCollapseValence = 40;
+
+// The area of the surface, polygons as fans of their vector area, in double precision (float
+// squares overflow near 1e19 and underflow near 1e-19).
+double surface_area(const Mesh& mesh) {
+  double area = 0;
+  for (Face f : mesh.faces()) {
+    Vec3d first{}, previous{}, normal{};
+    int k = 0;
+    for (Vertex v : mesh.vertices(f)) {
+      const Vec3d p = to_double(mesh.position(v));
+      if (k == 0)
+        first = p;
+      else if (k >= 2)
+        normal += cross(previous - first, p - first);
+      previous = p;
+      ++k;
+    }
+    area += 0.5 * norm(normal);
+  }
+  return area;
+}
 
 // Runs work(begin, end) over [0, n) on both cores when there is enough to share.
 template <class F>
@@ -360,21 +389,26 @@ void Remesher::compute_sizing() {
 }
 
 void Remesher::split_long_edges() {
-  for (Index i = 0; i < mesh_.edges_size(); ++i) {
-    const Edge e(i);
-    if (mesh_.is_deleted(e)) continue;
-    // Each split leaves the first half on e: split again until it is short enough; the
-    // other halves are new edges, met later in this loop.
-    for (;;) {
+  // In rounds, as pmp does: each round halves every edge that is still too long, once. Splitting
+  // one edge again and again until short instead, new edges included, fans every split out to
+  // the same far corner and multiplies slivers: a coarse mesh far above the target (a single
+  // polygon of a few hundred corners) then grew to millions of triangles in the first pass.
+  // Rounds refine evenly, about 4x per round, so the pass ends near area / L^2 triangles.
+  for (int round = 0; round < kMaxSplitRounds; ++round) {
+    bool split = false;
+    const Index n = static_cast<Index>(mesh_.edges_size());
+    for (Index i = 0; i < n; ++i) {
+      const Edge e(i);
+      if (mesh_.is_deleted(e)) continue;
       Halfedge h0 = Mesh::halfedge(e, 0), h1 = Mesh::halfedge(e, 1);
       Vertex a = mesh_.to_vertex(h1), b = mesh_.to_vertex(h0);
       double hi = 4.0 / 3.0 * size(a, b);
-      if (length_sq(a, b) <= hi * hi) break;
+      if (length_sq(a, b) <= hi * hi) continue;
       Vertex c = mesh_.is_boundary(h0) ? Vertex() : mesh_.to_vertex(mesh_.next(h0));
       Vertex d = mesh_.is_boundary(h1) ? Vertex() : mesh_.to_vertex(mesh_.next(h1));
       // Two triangles on the same third corner (a pillow, left by build() at non-manifold
       // spots) cannot be split: the new vertex would be joined to that corner twice.
-      if (c.is_valid() && c == d) break;
+      if (c.is_valid() && c == d) continue;
 
       Vertex v = mesh_.add_vertex(to_float((to_double(mesh_.position(a)) + to_double(mesh_.position(b))) * 0.5));
       const Index from[2] = {a.idx(), b.idx()};
@@ -394,7 +428,9 @@ void Remesher::split_long_edges() {
       curve_hint_[v.idx()] = curve_hint_[a.idx()] != kInvalidIndex ? curve_hint_[a.idx()] : curve_hint_[b.idx()];
       if (!sizing_.empty()) sizing_[v.idx()] = 0.5 * (sizing_[a.idx()] + sizing_[b.idx()]);
       ++report_.splits;
+      split = true;
     }
+    if (!split) break;
   }
 }
 
@@ -425,6 +461,11 @@ bool Remesher::star_ok(Vertex v, Vertex other, const Vec3d& target) const {
 // Whether from_vertex(h) may be removed by collapsing h, the kept vertex going to `target`.
 bool Remesher::may_collapse(Halfedge h, const Vec3d& target) const {
   const Vertex v0 = mesh_.from_vertex(h), v1 = mesh_.to_vertex(h);
+  // Every check below walks both stars. Around a corner of very high valence (a polygon of
+  // 100,000 corners triangulated: one corner joined to nearly all the others) each collapse
+  // there would cost O(valence), and merging such stars makes them larger still: quadratic,
+  // minutes for one polygon. Such vertices are thinned out by the flips instead.
+  if (degree_[v0.idx()].valence + degree_[v1.idx()].valence > kMaxCollapseValence) return false;
   const Kind k0 = kind_[v0.idx()];
   if (k0 == Kind::fixed) return false;
   // A sliding vertex may only move along its curve, onto the next vertex of it.
@@ -810,6 +851,19 @@ RemeshReport Remesher::run() {
           "target_edge_length");
   }
   report_.target_edge_length = length_;
+  // A target far below the input's edges (the mean edge of a 100,000-gon on its own disc, a
+  // length typed in the wrong units) would run for hours and exhaust memory: refuse it now.
+  const double area = surface_area(mesh_);
+  const double forecast = area / (std::sqrt(3.0) / 4.0 * length_ * length_);
+  if (forecast > double(options_.max_faces)) {
+    char text[320];
+    std::snprintf(text, sizeof text,
+                  "remesh: a target edge length of %.4g%s on a surface of area %.4g would make about %.3g "
+                  "triangles, more than the limit of %zu; give a larger target_edge_length",
+                  length_, options_.target_edge_length > 0 ? "" : " (the mean edge length of the input)", area,
+                  forecast, options_.max_faces);
+    throw Error(text);
+  }
 
   progress_.update(0.0, "triangulating");
   for (Face f : mesh_.faces())

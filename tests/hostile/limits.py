@@ -1,0 +1,40 @@
+"""Parameter values at and just beyond their limits, for every parameter of the catalogue
+(shared by tests/hostile/test_limits.py for the CLI and tests/blender/test_hostile.py for
+hedge.run): each limit itself must be accepted and run, the nearest value beyond it refused
+with a message naming the parameter."""
+import math
+
+
+def cases(p):
+    """[(value, accepted)] for parameter `p` (a catalogue dict of `hedge list --json`):
+    integers and reals at min and max and the nearest values beyond, every choice of an enum
+    and one that is not, both booleans."""
+    if p["type"] == "int":
+        return [(p["min"], True), (p["max"], True), (p["min"] - 1, False), (p["max"] + 1, False)]
+    if p["type"] == "float":
+        return [(float(p["min"]), True), (float(p["max"]), True),
+                (math.nextafter(float(p["min"]), -math.inf), False), (math.nextafter(float(p["max"]), math.inf), False),
+                (math.nan, False), (math.inf, False)]
+    if p["type"] == "enum":
+        return [(c, True) for c in p["choices"]] + [("no_such_" + p["id"], False)]
+    if p["type"] == "bool":
+        return [(True, True), (False, True)]
+    raise ValueError(f"unknown parameter type {p['type']}")
+
+
+def text(value):
+    """The value as typed on a command line: shortest round-trip text for reals."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, float):
+        if math.isnan(value):
+            return "nan"
+        if math.isinf(value):
+            return "inf" if value > 0 else "-inf"
+        return repr(value)
+    return str(value)
+
+
+def refusal_names_parameter(message, op_id, p):
+    """A refusal names the operation, the parameter and what is allowed."""
+    return f"{op_id}: parameter {p['id']} must be {p['range_text']}" in message
