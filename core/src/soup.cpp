@@ -94,7 +94,9 @@ void Soup::check() const {
         if (!std::isfinite(positions[v][k]))
           throw Error("soup: vertex " + std::to_string(v) + " has " +
                       (std::isnan(positions[v][k]) ? "a NaN" : "an infinite") + " coordinate (" + "xyz"[k] + " = " +
-                      (std::isnan(positions[v][k]) ? "nan" : positions[v][k] > 0 ? "inf" : "-inf") +
+                      (std::isnan(positions[v][k]) ? "nan"
+                       : positions[v][k] > 0       ? "inf"
+                                                   : "-inf") +
                       "); every coordinate must be a finite number");
   std::uint32_t largest = 0;
   for (std::uint32_t c : corners) largest = std::max(largest, c);
