@@ -64,6 +64,30 @@ struct LibraryStats {
 };
 LibraryStats& stats(const std::string& library);
 
+//! The memory benchmark of a peer: heap held by the mesh `build(reserve)` returns (a smart
+//! pointer), recorded in stats(library) with the counts `count(mesh)` gives as a pair.
+template <class Build, class Count>
+void measure_memory(benchmark::State& state, const std::string& library, bool reserve, Build build, Count count) {
+  LibraryStats& s = stats(library);
+  for (auto _ : state) {
+    HeapWindow heap;
+    auto mesh = build(reserve);
+    const auto [vertices, faces] = count(*mesh);
+    if (reserve) {
+      s.reserved_live_bytes = heap.live();
+    } else {
+      s.vertices = vertices;
+      s.faces = faces;
+      s.live_bytes = heap.live();
+      s.peak_bytes = heap.peak();
+      s.malloc_bytes = heap.malloc_live();
+    }
+    state.counters["MB"] = static_cast<double>(heap.live()) / 1e6;
+    state.counters["bytes_per_face"] = static_cast<double>(heap.live()) / static_cast<double>(faces);
+    mesh.reset();
+  }
+}
+
 //! One benchmark of one library. `op` is the table row (and the first part of the
 //! benchmark name, `op/library`).
 struct Entry {

@@ -131,23 +131,9 @@ void normals_loop(benchmark::State& state) {
 }
 
 void memory_of(benchmark::State& state, bool reserve) {
-  LibraryStats& s = stats("CGAL");
-  for (auto _ : state) {
-    HeapWindow heap;
-    auto mesh = build_mesh(reserve);
-    if (reserve) {
-      s.reserved_live_bytes = heap.live();
-    } else {
-      s.vertices = mesh->number_of_vertices();
-      s.faces = mesh->number_of_faces();
-      s.live_bytes = heap.live();
-      s.peak_bytes = heap.peak();
-      s.malloc_bytes = heap.malloc_live();
-    }
-    state.counters["MB"] = static_cast<double>(heap.live()) / 1e6;
-    state.counters["bytes_per_face"] = static_cast<double>(heap.live()) / static_cast<double>(mesh->number_of_faces());
-    mesh.reset();
-  }
+  measure_memory(state, "CGAL", reserve, build_mesh, [](const SMesh& mesh) {
+    return std::pair<std::size_t, std::size_t>(mesh.number_of_vertices(), mesh.number_of_faces());
+  });
 }
 void memory(benchmark::State& state) { memory_of(state, false); }
 void memory_reserved(benchmark::State& state) { memory_of(state, true); }

@@ -139,23 +139,9 @@ void normals_loop(benchmark::State& state) {
 }
 
 void memory_of(benchmark::State& state, bool reserve) {
-  LibraryStats& s = stats("OpenMesh");
-  for (auto _ : state) {
-    HeapWindow heap;
-    auto mesh = build_mesh(reserve);
-    if (reserve) {
-      s.reserved_live_bytes = heap.live();
-    } else {
-      s.vertices = mesh->n_vertices();
-      s.faces = mesh->n_faces();
-      s.live_bytes = heap.live();
-      s.peak_bytes = heap.peak();
-      s.malloc_bytes = heap.malloc_live();
-    }
-    state.counters["MB"] = static_cast<double>(heap.live()) / 1e6;
-    state.counters["bytes_per_face"] = static_cast<double>(heap.live()) / static_cast<double>(mesh->n_faces());
-    mesh.reset();
-  }
+  measure_memory(state, "OpenMesh", reserve, build_mesh, [](const OMesh& mesh) {
+    return std::pair<std::size_t, std::size_t>(mesh.n_vertices(), mesh.n_faces());
+  });
 }
 void memory(benchmark::State& state) { memory_of(state, false); }
 void memory_reserved(benchmark::State& state) { memory_of(state, true); }
