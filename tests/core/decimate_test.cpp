@@ -27,6 +27,7 @@
 #include "hedge/report.h"
 #include "hedge/topology.h"
 #include "hedge/validate.h"
+#include "test_meshes.h"
 
 namespace hedge {
 namespace {
@@ -109,19 +110,7 @@ Soup uv_cylinder() {
 
 // A bumpy open square (height field): one boundary loop.
 Soup bumpy_grid(int n) {
-  Soup s;
-  for (int j = 0; j <= n; ++j)
-    for (int i = 0; i <= n; ++i) {
-      const double x = double(i) / n, y = double(j) / n;
-      s.positions.push_back(Point{{float(x), float(y), float(0.1 * std::sin(6 * x) * std::cos(5 * y))}});
-    }
-  auto id = [n](int i, int j) { return std::uint32_t(j * (n + 1) + i); };
-  for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i) {
-      s.add_face({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
-      s.add_face({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
-    }
-  return s;
+  return test::height_field(n, 1.0, [](double x, double y) { return 0.1 * std::sin(6 * x) * std::cos(5 * y); });
 }
 
 double bbox_diagonal(const Mesh& mesh) { return mesh_statistics(mesh).bbox_diagonal; }

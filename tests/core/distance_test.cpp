@@ -14,6 +14,7 @@
 
 #include "hedge/build.h"
 #include "hedge/io.h"
+#include "test_meshes.h"
 
 namespace hedge {
 namespace {
@@ -22,16 +23,7 @@ Mesh mesh_of(const Soup& soup) { return build(soup).mesh; }
 
 // An n x n grid of squares (two triangles each) over [0, size]^2 at height z.
 Soup grid_soup(int n, double size, double z) {
-  Soup s;
-  for (int j = 0; j <= n; ++j)
-    for (int i = 0; i <= n; ++i) s.positions.push_back(Point{{float(size * i / n), float(size * j / n), float(z)}});
-  auto id = [n](int i, int j) { return std::uint32_t(j * (n + 1) + i); };
-  for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i) {
-      s.add_face({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
-      s.add_face({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
-    }
-  return s;
+  return test::height_field(n, size, [z](double, double) { return z; });
 }
 
 // A UV sphere of radius r around c.

@@ -17,6 +17,7 @@
 #include "hedge/io.h"
 #include "hedge/report.h"
 #include "hedge/validate.h"
+#include "test_meshes.h"
 
 namespace hedge {
 namespace {
@@ -88,19 +89,7 @@ Soup cube_soup(int n) {
 
 // An open, wavy n x n grid over [0, 1]^2 with fine boundary edges (triangles).
 Soup grid_soup(int n, double wave) {
-  Soup s;
-  for (int j = 0; j <= n; ++j)
-    for (int i = 0; i <= n; ++i) {
-      double x = double(i) / n, y = double(j) / n;
-      s.positions.push_back(Point{{float(x), float(y), float(wave * std::sin(3 * x) * std::cos(2 * y))}});
-    }
-  auto id = [n](int i, int j) { return std::uint32_t(j * (n + 1) + i); };
-  for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i) {
-      s.add_face({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
-      s.add_face({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
-    }
-  return s;
+  return test::height_field(n, 1.0, [wave](double x, double y) { return wave * std::sin(3 * x) * std::cos(2 * y); });
 }
 
 struct Quality {

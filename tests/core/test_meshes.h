@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "hedge/mesh.h"
+#include "hedge/soup.h"
 #include "hedge/validate.h"
 
 //! Fails the test (ASSERT) or records a failure (EXPECT) naming the broken invariant.
@@ -58,6 +59,25 @@ inline Mesh make_mesh(const std::vector<Point>& points, const std::vector<std::v
     mesh.set_halfedge(Vertex(v), h);
   }
   return mesh;
+}
+
+//! An n x n grid of squares over [0, size]^2, two triangles each, at z = height(x, y): an
+//! open surface with one boundary loop.
+template <class Height>
+Soup height_field(int n, double size, Height height) {
+  Soup s;
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) {
+      const double x = size * i / n, y = size * j / n;
+      s.positions.push_back(Point{{float(x), float(y), float(height(x, y))}});
+    }
+  auto id = [n](int i, int j) { return std::uint32_t(j * (n + 1) + i); };
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      s.add_face({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
+      s.add_face({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
+    }
+  return s;
 }
 
 }  // namespace hedge::test
