@@ -25,12 +25,9 @@ EXPECTED_REFUSALS = {
 
 # Known defects, reported but not failed: (case, operation) -> what goes wrong. When one no
 # longer happens the test says so (remove the entry).
-KNOWN_DEFECTS = {
-    # extract() welds build()'s vertex copies back; a filled hole next to the non-manifold
-    # vertex of the figure eight then has two corners on one vertex (the lead is fixing
-    # extract() in core/src/build.cpp).
-    ("self_crossing_polygon", "fill_holes"): "faces repeating a vertex after extract() welds the copies back",
-}
+# (None now: fill_holes on the figure eight gave faces repeating a vertex until extract()
+# learnt to keep such copies apart.)
+KNOWN_DEFECTS = {}
 
 
 def expected_refusal(case, op_id):
