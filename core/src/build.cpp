@@ -16,6 +16,8 @@
 #include <vector>
 
 #include "hedge/error.h"
+#include "hedge/limits.h"
+#include "hedge/threads.h"
 
 #ifdef __linux__
 #include <sys/mman.h>
@@ -38,7 +40,7 @@ constexpr std::size_t kMinParallel = std::size_t(1) << 16;
 // starting one; the split point is fixed, so results do not depend on timing.
 template <class Fn>
 void parallel_ranges(std::size_t n, Fn&& fn) {
-  if (n < kMinParallel || std::thread::hardware_concurrency() < 2) {
+  if (n < kMinParallel || thread_count() < 2) {
     fn(std::size_t(0), n);
     return;
   }
@@ -273,7 +275,7 @@ class Builder {
     soff_[nf_] = offset;
     status_.assign(nf_, kFaceOk);
     fmid_ = nf_;
-    if (nc_ >= kMinParallel && std::thread::hardware_concurrency() >= 2)
+    if (nc_ >= kMinParallel && thread_count() >= 2)
       fmid_ = static_cast<std::size_t>(std::upper_bound(soff_.begin(), soff_.end(), offset / 2) - soff_.begin()) - 1;
     struct Part {
       std::vector<std::uint32_t> skipped;
@@ -394,7 +396,7 @@ class Builder {
         }
       }
     };
-    if (nc_ >= kMinParallel && std::thread::hardware_concurrency() >= 2) {
+    if (nc_ >= kMinParallel && thread_count() >= 2) {
       // Split where half the corners lie, so both threads get equal work.
       const std::size_t mid = std::min<std::size_t>(
           nv_, static_cast<std::size_t>(std::upper_bound(vstart.begin(), vstart.end(), vstart[nv_] / 2) - vstart.begin()));
@@ -689,7 +691,7 @@ class Builder {
         }
       };
       std::size_t mid = nv;
-      if (n_entries >= kMinParallel && std::thread::hardware_concurrency() >= 2) {
+      if (n_entries >= kMinParallel && thread_count() >= 2) {
         // Split the vertices where half the entries lie, so both threads get equal work.
         mid = static_cast<std::size_t>(std::upper_bound(bstart.begin(), bstart.end(), bstart[nv] / 2) - bstart.begin());
         mid = std::min(mid, nv);
@@ -1189,10 +1191,13 @@ BuildResult build(const Soup& soup, const BuildOptions& options) {
     if (c.name.rfind("hedge:", 0) == 0)
       throw Error("soup: " + std::string(domain_name(c.domain)) + " channel '" + c.name +
                   "' uses the prefix 'hedge:', which is reserved for the mesh's own bookkeeping");
-  const std::size_t nv = soup.n_vertices(), nc = soup.n_corners();
-  if (nc >= kDirBit || nv + nc >= kInv || soup.n_faces() >= kInv)
-    throw Error("soup too large: " + std::to_string(nv) + " vertices and " + std::to_string(nc) +
-                " corners do not fit the mesh's 32-bit indices");
+  // Every corner is a half-edge, and its edge may need an outer one; each corner may
+  // become a vertex copy.
+  static_assert(kMaxCorners < kDirBit, "corner ids must leave the matching's direction bit free");
+  check_limit("soup too large", soup.n_corners(), kMaxCorners, "corners");
+  check_limit("soup too large", soup.n_faces(), kMaxElements, "faces");
+  check_limit("soup too large", std::uint64_t{soup.n_vertices()} + soup.n_corners(), kMaxElements,
+              "vertices with their possible copies (vertices plus corners)");
   return Builder(soup, options).run();
 }
 

@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "hedge/error.h"
+#include "hedge/threads.h"
 
 namespace hedge {
 
@@ -220,7 +221,8 @@ struct Builder {
     return id;
   }
 
-  // The root's two subtrees on two threads, then the second appended to the first.
+  // The root's two subtrees on two threads (when there are two), then the second appended
+  // to the first.
   void build_parallel(Index n, const Box& box, const Box& cbox, std::vector<BuildNode>& nodes) {
     Box child_box[2], child_cbox[2];
     Index mid = n > 65536 ? split(0, n, cbox, child_box, child_cbox) : 0;
@@ -231,23 +233,31 @@ struct Builder {
     nodes.emplace_back();
     set_box(nodes[0], box);
     std::vector<BuildNode> right;
-    std::exception_ptr failure;
-    std::thread other([&] {
-      try {
-        right.reserve(2 * (n - mid) / kLeafSize + 1);
-        build(mid, n, child_box[1], child_cbox[1], right, 1);
-      } catch (...) {
-        failure = std::current_exception();
-      }
-    });
-    try {
+    auto build_right = [&] {
+      right.reserve(2 * (n - mid) / kLeafSize + 1);
+      build(mid, n, child_box[1], child_cbox[1], right, 1);
+    };
+    if (thread_count() < 2) {  // the same tree, one subtree after the other
       build(0, mid, child_box[0], child_cbox[0], nodes, 1);
-    } catch (...) {
+      build_right();
+    } else {
+      std::exception_ptr failure;
+      std::thread other([&] {
+        try {
+          build_right();
+        } catch (...) {
+          failure = std::current_exception();
+        }
+      });
+      try {
+        build(0, mid, child_box[0], child_cbox[0], nodes, 1);
+      } catch (...) {
+        other.join();
+        throw;
+      }
       other.join();
-      throw;
+      if (failure) std::rethrow_exception(failure);
     }
-    other.join();
-    if (failure) std::rethrow_exception(failure);
     Index offset = static_cast<Index>(nodes.size());
     nodes[0].index = offset;
     nodes[0].count = 0;
@@ -596,7 +606,8 @@ OneSidedDistance one_sided_distance(const Mesh& from, const TriangleTree& to, co
     for (std::size_t b; (b = next.fetch_add(1)) < blocks.size();)
       sampler.run_block(blocks[b].kind, blocks[b].begin, blocks[b].end, partials[b]);
   };
-  unsigned threads = std::max(1u, std::min(options.threads, static_cast<unsigned>(blocks.size())));
+  unsigned threads =
+      std::max(1u, std::min(resolve_thread_count(options.threads), static_cast<unsigned>(blocks.size())));
   std::vector<std::thread> pool;
   for (unsigned t = 1; t < threads; ++t) pool.emplace_back(work);
   work();
@@ -632,7 +643,7 @@ HausdorffResult hausdorff(const Mesh& a, const Mesh& b, const HausdorffOptions& 
   if (a.n_faces() == 0 || b.n_faces() == 0) throw Error("Hausdorff distance: both meshes need faces");
   // The two trees are independent: build them side by side.
   TriangleTree tree_a, tree_b;
-  if (options.threads > 1) {
+  if (resolve_thread_count(options.threads) > 1) {
     std::exception_ptr failure;
     std::thread other([&] {
       try {

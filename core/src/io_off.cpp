@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "hedge/io.h"
+#include "hedge/limits.h"
 #include "io_detail.h"
 
 namespace hedge {
@@ -112,8 +113,10 @@ Soup read_off(const std::string& bytes, const std::string& name) {
   const std::uint64_t nv = counts[0], nf = counts[1];
   // A vertex takes at least "0 0 0\n", a face at least "0\n": counts the rest of the file
   // cannot hold are an error before anything is allocated.
+  if (nv > kMaxElements) fail_line(name, counts_line, limit_message(nv, kMaxElements, "vertices"));
+  if (nf > kMaxFaces) fail_line(name, counts_line, limit_message(nf, kMaxFaces, "faces"));
   const std::uint64_t room = in.remaining() + 1;
-  if (nv > 0xffffffffu || nf > 0xffffffffu || nv > room / 6 || nf > room / 2 || nv * 6 + nf * 2 > room)
+  if (nv > room / 6 || nf > room / 2 || nv * 6 + nf * 2 > room)
     fail_line(name, counts_line,
               "the header declares " + plural(nv, "vertex", "vertices") + " and " + plural(nf, "face") +
                   ", more than the rest of the file (" + plural(in.remaining(), "byte") + ") can hold");

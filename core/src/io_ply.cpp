@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "hedge/io.h"
+#include "hedge/limits.h"
 #include "io_detail.h"
 
 namespace hedge {
@@ -230,8 +231,7 @@ void assign_targets(Header& header, const std::string& name) {
       if (have_vertex) fail("a second element 'vertex'");
       have_vertex = true;
       e.kind = Kind::vertex;
-      if (e.count > 0xffffffffu)
-        fail("more vertices (" + std::to_string(e.count) + ") than hedge can index (2^32 - 1)");
+      if (e.count > kMaxElements) fail(limit_message(e.count, kMaxElements, "vertices"));
       for (const char* axis : {"x", "y", "z"})
         if (!scalar(axis)) fail("element 'vertex' has no scalar property '" + std::string(axis) + "'");
       group({"x", "y", "z"}, Target::position);
@@ -246,7 +246,7 @@ void assign_targets(Header& header, const std::string& name) {
       if (have_face) fail("a second element 'face'");
       have_face = true;
       e.kind = Kind::face;
-      if (e.count > 0xffffffffu) fail("more faces (" + std::to_string(e.count) + ") than hedge can index (2^32 - 1)");
+      if (e.count > kMaxFaces) fail(limit_message(e.count, kMaxFaces, "faces"));
       PlyProperty* indices = e.find("vertex_indices");
       if (!indices) indices = e.find("vertex_index");
       if (indices && indices->list)

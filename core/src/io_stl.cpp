@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "hedge/io.h"
+#include "hedge/limits.h"
 #include "io_detail.h"
 
 namespace hedge {
@@ -74,8 +75,7 @@ void weld(const std::vector<Point>& raw, Soup& soup) {
 }
 
 Soup read_binary(const std::string& bytes, std::uint32_t triangles, const std::string& name) {
-  if (3 * std::uint64_t{triangles} > 0xffffffffu)
-    fail_byte(name, 80, std::to_string(triangles) + " triangles: more corners than hedge can index");
+  if (triangles > kMaxFaces) fail_byte(name, 80, limit_message(triangles, kMaxFaces, "triangles"));
   const auto* p = reinterpret_cast<const unsigned char*>(bytes.data()) + kHeaderBytes;
   std::vector<Point> raw(3 * std::size_t{triangles});
   for (std::size_t t = 0; t < triangles; ++t, p += kTriangleBytes)

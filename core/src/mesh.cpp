@@ -5,6 +5,7 @@
 #include <algorithm>
 
 #include "hedge/error.h"
+#include "hedge/limits.h"
 
 namespace hedge {
 
@@ -37,9 +38,8 @@ void Mesh::shrink_to_fit() {
 
 namespace {
 // Handles are 32-bit; refuse growth that would wrap an index instead of corrupting.
-void check_capacity(std::size_t count, const char* what) {
-  if (count >= static_cast<std::size_t>(kInvalidIndex))
-    throw Error(std::string("mesh too large: more than 4,294,967,294 ") + what + " do not fit 32-bit indices");
+void check_capacity(std::size_t count, const char* what, std::uint64_t limit = kMaxElements) {
+  check_limit("mesh too large", count, limit, what);
 }
 }  // namespace
 
@@ -53,7 +53,7 @@ Vertex Mesh::new_vertex() {
 }
 
 Halfedge Mesh::new_edge(Vertex from, Vertex to) {
-  check_capacity(halfedges_size() + 2, "half-edges");
+  check_capacity(halfedges_size() + 2, "half-edges", kMaxHalfedges);
   halfedges_.push_back({to, Face(), Halfedge(), Halfedge()});
   halfedges_.push_back({from, Face(), Halfedge(), Halfedge()});
   hprops_.push_back();
@@ -81,7 +81,7 @@ void Mesh::resize(std::size_t vertices, std::size_t edges, std::size_t faces) {
 
 void Mesh::resize_unset(std::size_t vertices, std::size_t edges, std::size_t faces) {
   check_capacity(vertices, "vertices");
-  check_capacity(2 * edges, "half-edges");
+  check_capacity(2 * edges, "half-edges", kMaxHalfedges);
   check_capacity(faces, "faces");
   const std::size_t v0 = vertices_size(), h0 = halfedges_size(), f0 = faces_size();
   vertex_halfedge_.resize(vertices);

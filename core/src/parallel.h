@@ -7,18 +7,24 @@
 #include <thread>
 #include <vector>
 
+#include "hedge/threads.h"
+
 namespace hedge {
 
-//! Runs fn(begin, end) over [0, n) split across up to `threads` threads; ranges below `grain`
-//! elements per thread stay on the calling thread, where a thread would cost more than it
-//! saves. The first exception thrown by any part is rethrown after all parts have finished.
+//! Runs fn(begin, end) over [0, n) split across up to `threads` threads (0: thread_count());
+//! ranges below `grain` elements per thread stay on the calling thread, where a thread would
+//! cost more than it saves. The first exception thrown by any part is rethrown after all parts
+//! have finished.
 template <class Fn>
 void parallel_for(std::size_t n, unsigned threads, Fn&& fn, std::size_t grain = 32768) {
-  std::size_t t = std::min<std::size_t>(std::max(threads, 1u), std::max<std::size_t>(1, n / grain));
+  threads = resolve_thread_count(threads);
+  if (const std::size_t forced = testing::parallel_grain()) grain = forced;
+  std::size_t t = std::min<std::size_t>(threads, std::max<std::size_t>(1, n / grain));
   if (t <= 1) {
     fn(std::size_t(0), n);
     return;
   }
+  testing::count_parallel_split();
   std::vector<std::thread> pool;
   std::vector<std::exception_ptr> errors(t);
   for (std::size_t k = 1; k < t; ++k)

@@ -1,5 +1,6 @@
 // The `hedge` command line: info, convert, and every catalogue operation
 // (`hedge OP IN OUT --param value`), generated from the catalogue.
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -14,6 +15,7 @@
 #include "hedge/error.h"
 #include "hedge/io.h"
 #include "hedge/report.h"
+#include "hedge/threads.h"
 #include "hedge/topology.h"
 
 namespace {
@@ -30,7 +32,8 @@ constexpr const char* kUsage =
     "  hedge list [--json]               every operation with its parameters\n"
     "  hedge help OP                     one operation in full\n"
     "  hedge OP IN [OUT] [--param value ...] [--json] [--ascii]\n"
-    "                                    run an operation (OUT not needed for report)\n";
+    "                                    run an operation (OUT not needed for report)\n"
+    "environment: HEDGE_THREADS=N        threads to use (default: all cores; results never depend on it)\n";
 
 std::string flag_of(const std::string& id) {
   std::string flag = "--" + id;
@@ -243,6 +246,18 @@ int run(const std::string& id, const std::vector<std::string>& args) {
   return 0;
 }
 
+//! HEDGE_THREADS: a whole number from 1 to 1024; unset or empty means every core.
+void apply_thread_setting() {
+  const char* text = std::getenv("HEDGE_THREADS");
+  if (!text || !*text) return;
+  char* end = nullptr;
+  errno = 0;
+  const unsigned long n = std::strtoul(text, &end, 10);
+  if (errno || *end || n < 1 || n > 1024 || *text == '-' || *text == '+' || *text == ' ')
+    throw Error(std::string("HEDGE_THREADS must be a whole number from 1 to 1024, not '") + text + "'");
+  set_thread_count(static_cast<unsigned>(n));
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -254,6 +269,7 @@ int main(int argc, char** argv) {
   const std::string command = args[0];
   args.erase(args.begin());
   try {
+    apply_thread_setting();
     if (command == "info") return info(args);
     if (command == "convert") return convert(args);
     if (command == "distance") return distance_command(args);

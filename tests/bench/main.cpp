@@ -255,7 +255,9 @@ void usage() {
       "  --ops          instead: the table of whole operations (decimate, remesh, subdivide, smooth)\n"
       "                 against OpenMesh and CGAL in this process (ops.cpp)\n"
       "  --hosts        with --ops: also MeshLab (meshlabserver) and Blender (blender -b); slow\n"
-      "  --op-reps N    runs per library and operation in the --ops table (default 1)\n");
+      "  --op-reps N    runs per library and operation in the --ops table (default 1)\n"
+      "  --scale        instead: the pipeline on the mesh Loop-subdivided to 10M+ triangles, and\n"
+      "                 build/decimate cost per triangle from 100k to 14M (--scale-growth: only that)\n");
   benchmark::PrintDefaultHelp();
 }
 
@@ -267,6 +269,7 @@ int main(int argc, char** argv) {
   std::string dir = "build/meshes", mesh = "dragon.ply";
   int reps = 10, op_reps = 1;
   bool ops = false, hosts = false;
+  std::string scale;
   std::vector<char*> rest = {argv[0]};
   for (int i = 1; i < argc; ++i) {
     std::string a = argv[i];
@@ -296,6 +299,10 @@ int main(int argc, char** argv) {
       op_reps = std::max(1, std::atoi(reps_text.c_str()));
       continue;
     }
+    if (a == "--scale" || a == "--scale-growth") {
+      scale = a;
+      continue;
+    }
     if (a == "--help" || a == "-h") {
       usage();
       return 0;
@@ -309,6 +316,7 @@ int main(int argc, char** argv) {
 
   std::string path = mesh;
   if (mesh.find('/') == std::string::npos) path = (std::filesystem::path(dir) / mesh).string();
+  if (!scale.empty()) return bench::run_scale(path, scale == "--scale-growth");
 
   // Operation-major order, so each row's libraries run back to back in the same conditions.
   std::vector<std::vector<bench::Entry>> libraries = {bench::hedge_benchmarks(), bench::openmesh_benchmarks(),

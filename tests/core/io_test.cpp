@@ -307,8 +307,10 @@ TEST(IoOff, Errors) {
   EXPECT_THAT(err("OFF\n2 0 0\n0 0 0\n0 1 -inf\n"),
               HasSubstr("bad.off: soup: vertex 1 has an infinite coordinate (z = -inf)"));
   // A header claiming billions of elements in a tiny file is refused before allocating.
+  EXPECT_THAT(err("OFF\n400000000 400000000 0\n0 0 0\n"),
+              HasSubstr("bad.off: line 2: the header declares 400000000 vertices and 400000000 faces"));
   EXPECT_THAT(err("OFF\n4000000000 4000000000 0\n0 0 0\n"),
-              HasSubstr("bad.off: line 2: the header declares 4000000000 vertices and 4000000000 faces"));
+              HasSubstr("bad.off: line 2: 4,000,000,000 faces asked for, but hedge's 32-bit indices hold at most"));
   EXPECT_THAT(err("OFF\n99999999999999999999 1 0\n"), HasSubstr("bad.off: line 2: expected the number of vertices"));
 }
 
@@ -659,7 +661,8 @@ TEST(IoPly, HeaderErrors) {
               HasSubstr("bad.ply: line 3: element 'vertex' declares 1000 instances"));
   EXPECT_THAT(err(start + "element junk 18446744073709551615\nproperty list uchar int x\nend_header\n"),
               HasSubstr("bad.ply: line 3: element 'junk' declares 18446744073709551615 instances"));
-  EXPECT_THAT(err(start + "element vertex 5000000000\nend_header\n"), HasSubstr("bad.ply: line 3: more vertices"));
+  EXPECT_THAT(err(start + "element vertex 5000000000\nend_header\n"),
+              HasSubstr("bad.ply: line 3: 5,000,000,000 vertices asked for"));
 }
 
 TEST(IoPly, BodyErrors) {

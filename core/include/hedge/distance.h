@@ -96,7 +96,7 @@ struct HausdorffOptions {
   bool sample_vertices = true;        //!< also measure from every vertex
   bool sample_edge_midpoints = true;  //!< and from the midpoint of every edge
   std::uint64_t seed = 1;             //!< same seed, same samples, same result
-  unsigned threads = 2;               //!< worker threads (1 = this thread only)
+  unsigned threads = 0;               //!< worker threads (1 = this thread only, 0 = hedge::thread_count())
 };
 
 //! Distances from the samples of one surface to the other surface.

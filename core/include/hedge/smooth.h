@@ -29,7 +29,7 @@ struct SmoothOptions {
   //! curve (the mean of their two boundary neighbours), never across the hole.
   bool preserve_boundary = true;
   double pass_band = 0.1;  //!< Taubin's k_PB: μ = -λ / (1 - k_PB λ)
-  unsigned threads = 2;
+  unsigned threads = 0;    //!< 0: hedge::thread_count()
 };
 
 struct SmoothReport {

@@ -26,7 +26,7 @@ struct SubdivideOptions {
   SubdivisionScheme scheme = SubdivisionScheme::loop;
   int iterations = 1;                   //!< refinement steps, 1 or more
   std::size_t max_faces = 200'000'000;  //!< refuse (before starting) results larger than this
-  unsigned threads = 2;                 //!< for the stencils and the connectivity of big meshes
+  unsigned threads = 0;                 //!< for the stencils and the connectivity; 0: thread_count()
 };
 
 struct SubdivideReport {

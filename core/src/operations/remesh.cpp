@@ -6,16 +6,15 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <exception>
 #include <numbers>
 #include <optional>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "hedge/distance.h"
 #include "hedge/error.h"
 #include "hedge/report.h"
+#include "parallel.h"
 
 namespace hedge {
 namespace {
@@ -72,30 +71,10 @@ double surface_area(const Mesh& mesh) {
   return area;
 }
 
-// Runs work(begin, end) over [0, n) on both cores when there is enough to share.
+// The per-vertex passes: threads (hedge::thread_count()) pay off from 16384 vertices.
 template <class F>
 void parallel_for(std::size_t n, F&& work) {
-  if (n < 16384) {
-    work(std::size_t(0), n);
-    return;
-  }
-  const std::size_t mid = n / 2;
-  std::exception_ptr failure;
-  std::thread other([&] {
-    try {
-      work(mid, n);
-    } catch (...) {
-      failure = std::current_exception();
-    }
-  });
-  try {
-    work(std::size_t(0), mid);
-  } catch (...) {
-    other.join();
-    throw;
-  }
-  other.join();
-  if (failure) std::rethrow_exception(failure);
+  hedge::parallel_for(n, 0, std::forward<F>(work), 8192);
 }
 
 // Blends element `to` of dst from elements `from` of src (same layout): real numbers are
@@ -403,7 +382,7 @@ void Remesher::split_long_edges() {
       Halfedge h0 = Mesh::halfedge(e, 0), h1 = Mesh::halfedge(e, 1);
       Vertex a = mesh_.to_vertex(h1), b = mesh_.to_vertex(h0);
       double hi = 4.0 / 3.0 * size(a, b);
-      if (length_sq(a, b) <= hi * hi) continue;
+      if (!(length_sq(a, b) > hi * hi)) continue;  // a NaN size too
       Vertex c = mesh_.is_boundary(h0) ? Vertex() : mesh_.to_vertex(mesh_.next(h0));
       Vertex d = mesh_.is_boundary(h1) ? Vertex() : mesh_.to_vertex(mesh_.next(h1));
       // Two triangles on the same third corner (a pillow, left by build() at non-manifold
@@ -758,7 +737,7 @@ void Remesher::smooth_and_project() {
           auto corners = input_corners(c.triangle);
           double s = 0;
           for (int k = 0; k < 3; ++k) s += c.barycentric[k] * input_sizing_[input_.to_vertex(corners[k]).idx()];
-          sizing_[i] = s;
+          if (std::isfinite(s) && s > 0) sizing_[i] = s;  // no NaN from a zero-area triangle
         }
       } else if (!curves_.empty()) {
         ClosestPoint c = curves_.closest_point_with_hint(p, curve_hint_[i]);

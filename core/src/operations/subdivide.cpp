@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "hedge/error.h"
+#include "hedge/limits.h"
 #include "hedge/normals.h"
 #include "hedge/topology.h"
 #include "parallel.h"
@@ -914,6 +915,55 @@ std::size_t forecast_faces(const FaceCensus& c, const SubdivideOptions& options)
   return total >= 1e18 ? std::size_t(1e18) : std::size_t(total);
 }
 
+//! Refuses, before starting, subdivisions whose vertices, half-edges or faces would not fit
+//! the 32-bit indices (whatever max_faces allows): the counts of every step, in doubles so
+//! that nothing wraps. Each step of loop, midpoint and catmull_clark splits every edge and
+//! adds an edge per corner inside each face; sqrt3 keeps the edges and adds 3 per triangle.
+void check_index_limits(const Mesh& mesh, const FaceCensus& census, const SubdivideOptions& options, const char* name) {
+  double v = double(mesh.n_vertices()), e = double(mesh.n_edges()), f = double(census.faces);
+  double t = double(census.triangles), c = double(census.corners);
+  for (int it = 1; it <= options.iterations; ++it) {
+    switch (options.scheme) {
+      case SubdivisionScheme::loop:
+      case SubdivisionScheme::midpoint:
+      case SubdivisionScheme::catmull_clark: {
+        const bool quads = options.scheme == SubdivisionScheme::catmull_clark;
+        const double polygons = f - t;
+        v += e + (quads ? f : polygons);
+        e = 2 * e + c;
+        const double new_triangles = quads ? 0 : 4 * t;
+        f = quads ? c : new_triangles + (c - 3 * t);
+        c = quads ? 4 * c : 3 * new_triangles + 4 * (c - 3 * t);
+        t = new_triangles;
+        break;
+      }
+      case SubdivisionScheme::sqrt3:
+        v += f;
+        e += 3 * f;
+        f *= 3;
+        t = f;
+        c = 3 * f;
+        break;
+    }
+    const char* what = nullptr;
+    double count = 0, limit = 0;
+    if (2 * e > double(kMaxHalfedges)) {
+      what = "half-edges", count = 2 * e, limit = double(kMaxHalfedges);
+    } else if (v > double(kMaxElements)) {
+      what = "vertices", count = v, limit = double(kMaxElements);
+    } else if (f > double(kMaxElements)) {
+      what = "faces", count = f, limit = double(kMaxElements);
+    }
+    if (what)
+      throw Error("subdivide: " + std::to_string(options.iterations) + " iterations of " + name + " would need " +
+                  with_commas(count >= 1e19 ? std::uint64_t(1e19) : std::uint64_t(count)) + " " + what + " at step " +
+                  std::to_string(it) + ", but hedge's 32-bit indices hold at most " +
+                  with_commas(std::uint64_t(limit)) + " " + what + "; " +
+                  (it == 1 ? std::string("this mesh is too large to subdivide with this scheme")
+                           : "use at most " + std::to_string(it - 1) + (it == 2 ? " iteration" : " iterations")));
+  }
+}
+
 }  // namespace
 
 SubdivisionScheme subdivision_scheme_from_name(const std::string& name) {
@@ -953,6 +1003,7 @@ SubdivideReport subdivide(Mesh& mesh, const SubdivideOptions& options, Progress&
                   std::to_string(polygons) + (polygons == 1 ? " face has" : " faces have") +
                   " more than 3 corners; triangulate first, or use catmull_clark or midpoint");
   }
+  check_index_limits(mesh, census, options, name);
   const std::size_t predicted = forecast_faces(census, options);
   if (predicted > options.max_faces)
     throw Error("subdivide: " + std::to_string(options.iterations) + " iterations of " + name + " would make " +
