@@ -240,7 +240,14 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       case 7: {
         Halfedge h;
         if (pick(in, mesh, mesh.halfedges_size(), h) && mesh.is_boundary(h)) {
-          mesh.fill_hole(h);
+          // A loop of two edges or through a vertex twice is refused with an Error that
+          // changes nothing.
+          std::size_t faces = mesh.n_faces();
+          try {
+            mesh.fill_hole(h);
+          } catch (const hedge::Error&) {
+            if (mesh.n_faces() != faces) hedge_fuzz::fail("refused fill_hole changed the face count");
+          }
           check(mesh, "fill_hole");
         }
         break;

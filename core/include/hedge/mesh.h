@@ -338,7 +338,9 @@ class Mesh {
   //! from_vertex(h[i+1])); throws Error when they are not such a chain (a whole hole).
   //! Corner 0 is from_vertex(h[0]), as add_face(vertices) would make it.
   Face add_face(std::span<const Halfedge> halfedges);
-  //! Fills the hole whose loop holds boundary half-edge h with one face.
+  //! Fills the hole whose loop holds boundary half-edge h with one face. Throws Error,
+  //! leaving the mesh unchanged, when the loop cannot be one face: fewer than 3 edges (two
+  //! edges joining the same two vertices) or a vertex passed twice.
   Face fill_hole(Halfedge h);
   //! Removes an isolated vertex; throws Error when v has edges.
   void remove_isolated_vertex(Vertex v);
