@@ -18,7 +18,9 @@ if [ -n "$regressions" ] && [ -d "$regressions" ] && [ -n "$(ls -A "$regressions
 fi
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
-"$fuzzer" -max_total_time="$seconds" -rss_limit_mb=2048 -timeout=10 -max_len=4096 -print_final_stats=1 \
+# A fixed seed (HEDGE_FUZZ_SEED, default 1) makes a run's inputs the same on every machine,
+# so what CI finds can be found again here by running as long; 0 draws a fresh seed.
+"$fuzzer" -seed="${HEDGE_FUZZ_SEED:-1}" -max_total_time="$seconds" -rss_limit_mb=2048 -timeout=10 -max_len=4096 -print_final_stats=1 \
   -artifact_prefix="$work/artifacts/" "$work/corpus" >"$work/fuzz.log" 2>&1
 rc=$?
 execs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$work/fuzz.log" | grep -o '[0-9]*$' | tail -1)
