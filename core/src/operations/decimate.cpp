@@ -642,18 +642,26 @@ Decimator::Refusal Decimator::check(Halfedge h, const Point& target) const {
   if (!b0 && !b1 && int(vd_[v0.idx()].valence) + int(vd_[v1.idx()].valence) - 2 - removed_faces < 3) return kLowValence;
 
   // The two rings, in order: each entry is a neighbour and the face between it and the next.
-  auto gather = [&](Vertex v, std::vector<RingEntry>& ring) {
-    ring.clear();
-    for (Halfedge x : m_.outgoing(v)) {
-      const Vertex w = m_.to_vertex(x);
-      // The fold test below reads every neighbour's position: start those cache misses now,
-      // so they overlap the link test instead of following it one by one.
-      __builtin_prefetch(&m_.position(w));
-      ring.push_back({w, m_.face(x), Vec3d{}});
-    }
+  // Both rings are walked at once: each step waits for the half-edge the previous one
+  // named, so two walks side by side overlap their cache misses instead of queueing them.
+  ring0_.clear();
+  ring1_.clear();
+  const Halfedge start0 = m_.halfedge(v0), start1 = m_.halfedge(v1);
+  Halfedge x0 = start0, x1 = start1;
+  bool more0 = true, more1 = true;  // neither end is isolated: both have h
+  auto step = [&](Halfedge& x, Halfedge start, bool& more, std::vector<RingEntry>& ring) {
+    const Vertex w = m_.to_vertex(x);
+    // The fold test below reads every neighbour's position: start those cache misses now,
+    // so they overlap the link test instead of following it one by one.
+    __builtin_prefetch(&m_.position(w));
+    ring.push_back({w, m_.face(x), Vec3d{}});
+    x = m_.ccw_rotated(x);
+    more = x != start;
   };
-  gather(v0, ring0_);
-  gather(v1, ring1_);
+  while (more0 || more1) {
+    if (more0) step(x0, start0, more0, ring0_);
+    if (more1) step(x1, start1, more1, ring1_);
+  }
   // Link condition: the only common neighbours are vl and vr; and a second edge v0 - v1
   // would become a loop. The rings are short, so plain scans beat marking arrays.
   int edges_to_v1 = 0;
