@@ -11,6 +11,7 @@
 #include <ctime>
 #include <filesystem>
 #include <map>
+#include <numbers>
 #include <set>
 #include <utility>
 #include <vector>
@@ -18,7 +19,9 @@
 #include "hedge/build.h"
 #include "hedge/error.h"
 #include "hedge/io.h"
+#include "hedge/normals.h"
 #include "hedge/report.h"
+#include "hedge/threads.h"
 #include "hedge/topology.h"
 #include "hedge/validate.h"
 #include "test_meshes.h"
@@ -650,10 +653,365 @@ TEST(Subdivide, RunsThroughTheHostPipelineWithAttributes) {
   }
 }
 
+// ---- creases (crease_angle) ------------------------------------------------------------------
+
+SubdivideOptions creased(SubdivisionScheme s, double crease_angle, int iterations = 1) {
+  SubdivideOptions o = scheme(s, iterations);
+  o.crease_angle = crease_angle;
+  return o;
+}
+
+Mesh triangulated_cube() {
+  const Mesh cube = unit_cube();
+  std::vector<Point> p;
+  for (Vertex v : cube.vertices()) p.push_back(cube.position(v));
+  std::vector<std::vector<Index>> f;
+  for (Face x : cube.faces()) {
+    std::vector<Index> c;
+    for (Vertex v : cube.vertices(x)) c.push_back(v.idx());
+    f.push_back({c[0], c[1], c[2]});
+    f.push_back({c[0], c[2], c[3]});
+  }
+  return make_mesh(p, f);
+}
+
+bool at_side(float x) { return std::abs(x) < 1e-6f || std::abs(x - 1) < 1e-6f; }
+
+//! Checks that every vertex lies on the unit cube's surface; returns how many lie on its
+//! edges (two coordinates at 0 or 1).
+std::size_t on_unit_cube(const Mesh& m) {
+  std::size_t on_edges = 0;
+  for (Vertex v : m.vertices()) {
+    const Point& p = m.position(v);
+    int sides = 0;
+    for (int i = 0; i < 3; ++i) {
+      EXPECT_GE(p[i], -1e-6f) << "vertex " << v.idx();
+      EXPECT_LE(p[i], 1 + 1e-6f) << "vertex " << v.idx();
+      sides += at_side(p[i]);
+    }
+    EXPECT_GE(sides, 1) << "vertex " << v.idx() << " (" << p[0] << ", " << p[1] << ", " << p[2] << ") is inside";
+    on_edges += sides >= 2;
+  }
+  return on_edges;
+}
+
+// Every cube edge (90 degrees) is a crease at 60 and every corner has three: the corners stay,
+// the edges refine as straight lines, the flat sides stay flat.
+TEST(SubdivideCreases, CreasedCubeStaysTheCube) {
+  for (auto s : {SubdivisionScheme::catmull_clark, SubdivisionScheme::loop}) {
+    const Mesh before = s == SubdivisionScheme::loop ? triangulated_cube() : unit_cube();
+    for (int iterations : {1, 3}) {
+      Mesh mesh = before;
+      const SubdivideReport r = subdivide(mesh, creased(s, 60, iterations));
+      expect_valid(mesh);
+      EXPECT_EQ(r.crease_edges, 12u) << subdivision_scheme_name(s);  // not the triangulation's diagonals
+      for (Index v = 0; v < 8; ++v) EXPECT_EQ(mesh.position(Vertex(v)), before.position(Vertex(v)));
+      // Each cube edge is cut into 2^iterations pieces: its inner points and the 8 corners.
+      const std::size_t pieces = std::size_t(1) << iterations;
+      EXPECT_EQ(on_unit_cube(mesh), 8 + 12 * (pieces - 1)) << subdivision_scheme_name(s) << " x" << iterations;
+      // The first step puts the points of the cube's edges at their midpoints.
+      if (iterations == 1)
+        for (Edge e : before.edges()) {
+          const Vec3d mid = (at(before, before.vertex(e, 0).idx()) + at(before, before.vertex(e, 1).idx())) * 0.5;
+          const int halves = (mid[0] == 0.5) + (mid[1] == 0.5) + (mid[2] == 0.5);
+          if (halves == 1) expect_point(mesh.position(Vertex(8 + e.idx())), mid);
+        }
+      EXPECT_NEAR(mesh_statistics(mesh).area, 6.0, 1e-4) << subdivision_scheme_name(s);
+    }
+    // The control: without creases the same cube rounds off.
+    Mesh smooth = before;
+    EXPECT_EQ(subdivide(smooth, creased(s, 180)).crease_edges, 0u);
+    EXPECT_NE(smooth.position(Vertex(0)), before.position(Vertex(0)));
+  }
+}
+
+// The tetrahedron (0,0,0), (1,0,0), (0,1,0), (0,0,1): its three edges at the origin bend by
+// 90 degrees, the three of the slanted face by 125.3. At 100 only the latter are creases:
+// vertex 0 is smooth, vertices 1, 2, 3 are crease vertices (two creases each).
+TEST(SubdivideCreases, HandComputedCreaseRules) {
+  const Mesh before = tetrahedron();
+  const Edge e01 = before.find_edge(Vertex(0), Vertex(1)), e12 = before.find_edge(Vertex(1), Vertex(2));
+  ASSERT_TRUE(e01.is_valid() && e12.is_valid());
+
+  // Per scheme, the smooth vertex 0 and the smooth edge 0-1. Loop, valence 3: 7/16 itself and
+  // 3/16 each neighbour; 3/8 (0 + 1) + 1/8 (2 + 3). Catmull-Clark, n = 3: 1/3 itself, 1/9 each
+  // neighbour and each of its face centroids (1/3,1/3,0), (1/3,0,1/3), (0,1/3,1/3), so
+  // 1/9 + 2/27 = 5/27 per coordinate; ((0,0,0) + (1,0,0) + (1/3,1/3,0) + (1/3,0,1/3)) / 4.
+  const struct {
+    SubdivisionScheme scheme;
+    Vec3d vertex0, edge01;
+  } cases[] = {{SubdivisionScheme::loop, {{3.0 / 16, 3.0 / 16, 3.0 / 16}}, {{3.0 / 8, 1.0 / 8, 1.0 / 8}}},
+               {SubdivisionScheme::catmull_clark, {{5.0 / 27, 5.0 / 27, 5.0 / 27}}, {{5.0 / 12, 1.0 / 12, 1.0 / 12}}}};
+  for (const auto& c : cases) {
+    Mesh mesh = before;
+    EXPECT_EQ(subdivide(mesh, creased(c.scheme, 100)).crease_edges, 3u);
+    expect_valid(mesh);
+    expect_point(mesh.position(Vertex(0)), c.vertex0);
+    expect_point(mesh.position(Vertex(4 + e01.idx())), c.edge01);
+    // The same crease rules in both: vertex 1 is 6/8 (1,0,0) + 1/8 (0,1,0) + 1/8 (0,0,1), the
+    // point of crease edge 1-2 its midpoint.
+    expect_point(mesh.position(Vertex(1)), {{0.75, 0.125, 0.125}});
+    expect_point(mesh.position(Vertex(4 + e12.idx())), {{0.5, 0.5, 0}});
+  }
+
+  // At 130 nothing is sharp enough, at 60 everything: all corners, so Loop is the midpoint rule.
+  Mesh none = before;
+  EXPECT_EQ(subdivide(none, creased(SubdivisionScheme::loop, 130)).crease_edges, 0u);
+  expect_point(none.position(Vertex(1)), {{7.0 / 16, 3.0 / 16, 3.0 / 16}});
+  Mesh all = before;
+  EXPECT_EQ(subdivide(all, creased(SubdivisionScheme::loop, 60)).crease_edges, 6u);
+  for (Index v = 0; v < 4; ++v) EXPECT_EQ(all.position(Vertex(v)), before.position(Vertex(v)));
+  expect_point(all.position(Vertex(4 + e01.idx())), {{0.5, 0, 0}});
+}
+
+// Default and 180 are the crease-free rules, bit for bit, and so is an angle no edge exceeds.
+TEST(SubdivideCreases, NoCreaseIsTheOldResult) {
+  for (auto s : {SubdivisionScheme::loop, SubdivisionScheme::catmull_clark}) {
+    Mesh reference = tetrahedron();
+    subdivide(reference, scheme(s, 2));
+    for (double angle : {180.0, 130.0}) {
+      Mesh mesh = tetrahedron();
+      subdivide(mesh, creased(s, angle, 2));
+      ASSERT_EQ(mesh.n_vertices(), reference.n_vertices());
+      for (Vertex v : mesh.vertices()) EXPECT_EQ(mesh.position(v), reference.position(v)) << angle;
+    }
+  }
+  // A flat grid bends nowhere, even at 0 degrees.
+  Mesh flat = grid(3), reference = grid(3);
+  subdivide(reference, scheme(SubdivisionScheme::loop));
+  EXPECT_EQ(subdivide(flat, creased(SubdivisionScheme::loop, 0)).crease_edges, 0u);
+  for (Vertex v : flat.vertices()) EXPECT_EQ(flat.position(v), reference.position(v));
+}
+
+// A fan of 8 triangles around the origin, ring vertex k at angle 45k degrees and height
+// |sin(22.5 k degrees)|: the spoke to ring vertex 0 bends by 57 degrees, every other spoke by
+// 25 or less. At 40 the centre is a dart (one crease: the smooth rule) and ring vertex 0 a
+// corner (its two boundary edges and the crease: fixed); the other ring vertices follow the
+// boundary rule.
+Mesh dart_fan() {
+  std::vector<Point> p = {{{0, 0, 0}}};
+  for (int k = 0; k < 8; ++k) {
+    const double t = 2 * std::numbers::pi * k / 8;
+    p.push_back({{float(std::cos(t)), float(std::sin(t)), float(std::abs(std::sin(t / 2)))}});
+  }
+  std::vector<std::vector<Index>> f;
+  for (Index k = 0; k < 8; ++k) f.push_back({0, 1 + k, 1 + (k + 1) % 8});
+  return make_mesh(p, f);
+}
+
+Vec3d loop_smooth(const Mesh& m, Vertex v) {
+  const double n = double(m.valence(v));
+  const double c = 3.0 / 8.0 + 0.25 * std::cos(2.0 * std::numbers::pi / n), beta = (5.0 / 8.0 - c * c) / n;
+  Vec3d want = at(m, v.idx()) * (1 - n * beta);
+  for (Vertex w : m.vertices(v)) want += at(m, w.idx()) * beta;
+  return want;
+}
+
+TEST(SubdivideCreases, DartIsSmoothCornerIsFixed) {
+  const Mesh before = dart_fan();
+  Mesh mesh = before;
+  EXPECT_EQ(subdivide(mesh, creased(SubdivisionScheme::loop, 40)).crease_edges, 1u);
+  expect_valid(mesh);
+  expect_point(mesh.position(Vertex(0)), loop_smooth(before, Vertex(0)), 1e-5);  // dart
+  EXPECT_EQ(mesh.position(Vertex(1)), before.position(Vertex(1)));               // corner
+  // Ring vertex 2 on the boundary: 6/8 itself, 1/8 ring vertices 1 and 3.
+  expect_point(mesh.position(Vertex(2)), at(before, 2) * 0.75 + (at(before, 1) + at(before, 3)) * 0.125, 1e-6);
+  // The crease's point is its midpoint; the next spoke's is Loop's 3/8, 3/8, 1/8, 1/8.
+  const Edge crease = before.find_edge(Vertex(0), Vertex(1)), spoke = before.find_edge(Vertex(0), Vertex(2));
+  const Index V = 9;
+  expect_point(mesh.position(Vertex(V + crease.idx())), (at(before, 0) + at(before, 1)) * 0.5);
+  expect_point(mesh.position(Vertex(V + spoke.idx())),
+               (at(before, 0) + at(before, 2)) * 0.375 + (at(before, 1) + at(before, 3)) * 0.125);
+
+  // Second step of the same run: the crease's two halves are still creases, so its point
+  // (vertex V + crease) is a crease vertex between the centre and ring vertex 1, and the
+  // centre is still a dart; nothing is measured again.
+  Mesh twice = before;
+  subdivide(twice, creased(SubdivisionScheme::loop, 40, 2));
+  expect_valid(twice);
+  const Index m = V + crease.idx();
+  expect_point(twice.position(Vertex(m)), at(mesh, m) * 0.75 + (at(mesh, 0) + at(mesh, 1)) * 0.125, 1e-6);
+  expect_point(twice.position(Vertex(0)), loop_smooth(mesh, Vertex(0)), 1e-5);
+  EXPECT_EQ(twice.position(Vertex(1)), before.position(Vertex(1)));
+  // Without creases the centre and ring vertex 1 would move differently.
+  Mesh smooth = before;
+  subdivide(smooth, scheme(SubdivisionScheme::loop));
+  EXPECT_NE(smooth.position(Vertex(1)), before.position(Vertex(1)));
+}
+
+// A sheet folded along x = 2 (z = |x - 2|, a 90 degree ridge) with uv = xy and a vertex
+// colour equal to the position: with the crease the sheet stays two planes, the ridge's
+// ends (boundary corners) stay, and the attributes follow the crease stencils.
+Mesh folded_sheet(bool triangles) {
+  Mesh mesh = grid(4, triangles);
+  for (Vertex v : mesh.vertices()) mesh.position(v)[2] = std::abs(mesh.position(v)[0] - 2);
+  ChannelArray* uv = mesh.halfedge_properties().add_channel("uv", ScalarType::f32, 2);
+  for (Face f : mesh.faces())
+    for (Halfedge h : mesh.halfedges(f)) {
+      const Point& p = mesh.position(mesh.to_vertex(h));
+      const float value[2] = {p[0], p[1]};
+      std::memcpy(uv->element(h.idx()), value, sizeof value);
+    }
+  ChannelArray* color = mesh.vertex_properties().add_channel("color", ScalarType::f32, 3);
+  for (Vertex v : mesh.vertices()) std::memcpy(color->element(v.idx()), &mesh.position(v), sizeof(Point));
+  return mesh;
+}
+
+TEST(SubdivideCreases, FoldStaysAFoldAndCarriesAttributes) {
+  for (auto s : {SubdivisionScheme::loop, SubdivisionScheme::catmull_clark}) {
+    const char* name = subdivision_scheme_name(s);
+    Mesh mesh = folded_sheet(s == SubdivisionScheme::loop);
+    const std::size_t corners_before = mesh.halfedge_properties().get_channel("uv")->size();
+    EXPECT_EQ(subdivide(mesh, creased(s, 60, 2)).crease_edges, 4u) << name;
+    expect_valid(mesh);
+    for (Vertex v : mesh.vertices()) {
+      const Point& p = mesh.position(v);
+      EXPECT_NEAR(p[2], std::abs(p[0] - 2), 1e-5f) << name << " vertex " << v.idx();
+    }
+    // The ridge's ends, (2, 0) and (2, 4), are corners; the ridge vertex (2, 2) stays on it.
+    EXPECT_EQ(mesh.position(Vertex(2)), (Point{{2, 0, 0}})) << name;
+    EXPECT_EQ(mesh.position(Vertex(22)), (Point{{2, 4, 0}})) << name;
+    expect_point(mesh.position(Vertex(12)), {{2, 2, 0}});
+
+    const ChannelArray* uv = mesh.halfedge_properties().get_channel("uv");
+    const ChannelArray* color = mesh.vertex_properties().get_channel("color");
+    ASSERT_TRUE(uv && color) << name;
+    EXPECT_GT(uv->size(), corners_before);
+    for (Vertex v : mesh.vertices()) {
+      Point c;
+      std::memcpy(&c, color->element(v.idx()), sizeof c);
+      expect_point(c, to_double(mesh.position(v)), 1e-5);
+    }
+    // Corners on the ridge: positions and uvs both move along the line x = 2 by linear rules.
+    std::size_t on_ridge = 0;
+    for (Face f : mesh.faces())
+      for (Halfedge h : mesh.halfedges(f)) {
+        const Point& p = mesh.position(mesh.to_vertex(h));
+        if (p[0] != 2.0f) continue;
+        float value[2];
+        std::memcpy(value, uv->element(h.idx()), sizeof value);
+        EXPECT_NEAR(value[0], 2.0f, 1e-6f) << name;
+        EXPECT_NEAR(value[1], p[1], 1e-5f) << name;
+        ++on_ridge;
+      }
+    EXPECT_GT(on_ridge, 16u) << name;  // 17 ridge vertices after two steps, each in 2+ faces
+  }
+}
+
+TEST(SubdivideCreases, Refusals) {
+  Mesh mesh = tetrahedron();
+  try {
+    subdivide(mesh, creased(SubdivisionScheme::sqrt3, 60));
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("crease_angle is not supported by the sqrt3 scheme"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_EQ(mesh.n_faces(), 4u);
+  for (double bad : {-1.0, 181.0, std::nan("")})
+    EXPECT_THROW(subdivide(mesh, creased(SubdivisionScheme::loop, bad)), Error);
+  EXPECT_EQ(mesh.n_faces(), 4u);
+  subdivide(mesh, creased(SubdivisionScheme::sqrt3, 180));  // 180: no creases, allowed
+  EXPECT_EQ(mesh.n_faces(), 12u);
+  // midpoint is linear: creases change nothing.
+  Mesh plain = unit_cube(), with = unit_cube();
+  subdivide(plain, scheme(SubdivisionScheme::midpoint));
+  EXPECT_EQ(subdivide(with, creased(SubdivisionScheme::midpoint, 60)).crease_edges, 12u);
+  for (Vertex v : plain.vertices()) EXPECT_EQ(plain.position(v), with.position(v));
+}
+
+TEST(SubdivideCreases, CatalogueParameter) {
+  const Operation& op = find_operation("subdivide");
+  const ParamSpec* p = op.find_param("crease_angle");
+  ASSERT_NE(p, nullptr);
+  EXPECT_EQ(p->type, ParamType::real);
+  EXPECT_EQ(p->default_value, 180);
+  EXPECT_EQ(p->min, 0);
+  EXPECT_EQ(p->max, 180);
+  EXPECT_FALSE(p->help.empty());
+  Mesh mesh = unit_cube();
+  OperationReport r = op.run(
+      mesh, resolve_params(op, std::map<std::string, std::string>{{"scheme", "catmull_clark"}, {"crease_angle", "60"}}),
+      Progress::none());
+  expect_valid(mesh);
+  ASSERT_NE(r.find("crease_edges"), nullptr);
+  EXPECT_EQ(std::get<std::int64_t>(*r.find("crease_edges")), 12);
+  EXPECT_EQ(on_unit_cube(mesh), 8u + 12u);
+  EXPECT_THROW(resolve_params(op, std::map<std::string, std::string>{{"crease_angle", "181"}}), Error);
+  // The default adds nothing to the report.
+  Mesh plain = unit_cube();
+  r = op.run(plain, resolve_params(op, std::map<std::string, std::string>{{"scheme", "catmull_clark"}}),
+             Progress::none());
+  EXPECT_EQ(r.find("crease_edges"), nullptr);
+}
+
 Mesh load(const std::string& name) {
   const std::string path = std::string(HEDGE_MESH_DIR) + "/" + name;
   if (!std::filesystem::exists(path)) return Mesh();
   return build(read_mesh(path)).mesh;
+}
+
+// Creases are measured on the input only. On the bunny at 30 degrees, measuring the first
+// step's result again would find other creases (halves of some creases flatten below 30),
+// so a second call differs from a second step; in the one call of two steps, the point of
+// every input crease keeps the curve rule between its edge's ends.
+TEST(SubdivideCreases, CreasesAreMeasuredOnceOnTheInput) {
+  const Mesh bunny = load("bunny.off");
+  if (bunny.is_empty()) GTEST_SKIP() << "bunny.off not found";
+  const std::vector<Vec3f> normal = face_normals(bunny);
+  std::vector<Edge> creases;
+  for (Edge e : bunny.edges()) {
+    if (bunny.is_boundary(e)) continue;
+    const Vec3d a = to_double(normal[bunny.face(Mesh::halfedge(e, 0)).idx()]);
+    const Vec3d b = to_double(normal[bunny.face(Mesh::halfedge(e, 1)).idx()]);
+    if (std::atan2(norm(cross(a, b)), dot(a, b)) * 180 / std::numbers::pi > 30) creases.push_back(e);
+  }
+  Mesh once = bunny, twice = bunny;
+  const SubdivideReport r = subdivide(once, creased(SubdivisionScheme::loop, 30));
+  subdivide(twice, creased(SubdivisionScheme::loop, 30, 2));
+  expect_valid(twice);
+  ASSERT_EQ(r.crease_edges, creases.size());
+  ASSERT_GT(creases.size(), 100u);
+  const Index V = Index(bunny.vertices_size());
+  for (Edge e : creases) {
+    const Index m = V + e.idx(), a = bunny.vertex(e, 0).idx(), b = bunny.vertex(e, 1).idx();
+    expect_point(twice.position(Vertex(m)), at(once, m) * 0.75 + (at(once, a) + at(once, b)) * 0.125, 1e-5);
+  }
+  Mesh again = once;
+  subdivide(again, creased(SubdivisionScheme::loop, 30));
+  std::size_t differ = 0;
+  for (Vertex v : twice.vertices()) differ += again.position(v) != twice.position(v);
+  EXPECT_GT(differ, 0u);
+}
+
+// The crease rules read a table made once before the steps: the result is the same at
+// every thread count (small grain so the bunny takes the multi-threaded paths).
+TEST(SubdivideCreases, SameResultAtEveryThreadCount) {
+  const Mesh bunny = load("bunny.off");
+  if (bunny.is_empty()) GTEST_SKIP() << "bunny.off not found";
+  for (auto s : {SubdivisionScheme::loop, SubdivisionScheme::catmull_clark}) {
+    Mesh reference;
+    for (unsigned threads : {1u, 2u, 3u, 8u}) {
+      hedge::testing::set_parallel_grain(64);
+      const std::size_t splits = hedge::testing::parallel_splits();
+      Mesh mesh = bunny;
+      SubdivideOptions o = creased(s, 30, 2);
+      o.threads = threads;
+      const SubdivideReport r = subdivide(mesh, o);
+      hedge::testing::set_parallel_grain(0);
+      EXPECT_GT(r.crease_edges, 0u);
+      if (threads == 1) {
+        reference = mesh;
+        continue;
+      }
+      EXPECT_GT(hedge::testing::parallel_splits(), splits);
+      ASSERT_EQ(mesh.n_vertices(), reference.n_vertices());
+      EXPECT_EQ(
+          std::memcmp(mesh.positions().data(), reference.positions().data(), sizeof(Point) * mesh.positions().size()),
+          0)
+          << subdivision_scheme_name(s) << " at " << threads << " threads";
+    }
+  }
 }
 
 TEST(Subdivide, BunnyAllSchemes) {

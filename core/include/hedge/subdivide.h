@@ -27,11 +27,15 @@ struct SubdivideOptions {
   int iterations = 1;                   //!< refinement steps, 1 or more
   std::size_t max_faces = 200'000'000;  //!< refuse (before starting) results larger than this
   unsigned threads = 0;                 //!< for the stencils and the connectivity; 0: thread_count()
+  //! Degrees, 0 to 180: an interior edge whose two faces' normals differ by more is a crease
+  //! (kept sharp, see subdivide()). 180: none. Refused by sqrt3 below 180.
+  double crease_angle = 180;
 };
 
 struct SubdivideReport {
   std::size_t vertices = 0, edges = 0, faces = 0;  //!< of the result
   int iterations = 0;
+  std::size_t crease_edges = 0;  //!< interior edges of the input found sharper than crease_angle
 };
 
 //! Face count after `options.iterations` steps of `options.scheme`, without refining.
@@ -50,6 +54,17 @@ std::size_t subdivided_face_count(const Mesh& mesh, const SubdivideOptions& opti
 //! points, (4, 19, 4)/27 for the old), so an even number of iterations refines the
 //! boundary as finely as the interior.
 //!
+//! Creases (options.crease_angle < 180) are found once, on the input; the two halves of a
+//! crease edge stay creases in later steps, new edges never are. Loop follows Hoppe et al.
+//! 1994 ("Piecewise smooth surface reconstruction"), Catmull–Clark the sharp creases of DeRose,
+//! Kass & Truong 1998, with boundary edges counted as crease edges: a crease edge point is the
+//! midpoint; a vertex on two crease edges (or a boundary vertex on its two boundary edges)
+//! takes the curve rule (1/8, 6/8, 1/8) over the two far ends; a corner (three or more, e.g.
+//! a boundary vertex with an interior crease) stays where it is; a dart (one crease) takes
+//! the smooth rule. Copies of a vertex split by build() are classified each on its own.
+//! sqrt3 refuses crease_angle < 180 (Error): its flips and boundary trisection would need
+//! their own connectivity for creases. midpoint is linear, so creases change nothing there.
+//!
 //! Attributes: vertex properties are blended with the same stencils as positions (integer
 //! channels take the value of the heaviest source); corner properties are blended
 //! linearly inside each old face (midpoints, centroids), so seams stay seams; face
@@ -63,11 +78,12 @@ std::size_t subdivided_face_count(const Mesh& mesh, const SubdivideOptions& opti
 //! catmull_clark and midpoint put the point of edge e at vertex V + e and face points after
 //! those, in face order; sqrt3 puts the point of face f at V + f.
 //!
-//! Throws Error, leaving the mesh untouched, for polygons under loop/sqrt3 and results above
-//! options.max_faces; Cancelled through progress likewise.
+//! Throws Error, leaving the mesh untouched, for polygons under loop/sqrt3, results above
+//! options.max_faces, crease_angle outside 0 to 180 or below 180 with sqrt3; Cancelled
+//! through progress likewise.
 SubdivideReport subdivide(Mesh& mesh, const SubdivideOptions& options, Progress& progress = Progress::none());
 
-//! The catalogue entry "subdivide" (parameters scheme, iterations).
+//! The catalogue entry "subdivide" (parameters scheme, iterations, crease_angle).
 Operation subdivide_operation();
 
 }  // namespace hedge

@@ -335,7 +335,32 @@ SplitPlan plan_split(const Mesh& m, SubdivisionScheme scheme) {
   return plan;
 }
 
-Mesh split_step(const Mesh& m, SubdivisionScheme scheme, unsigned threads, Progress& progress, double from, double to) {
+//! Creases of the input (subdivide.h): interior edges whose faces' normals differ by more than
+//! `degrees`. Degenerate faces (zero normal) bend nothing.
+std::vector<bool> detect_creases(const Mesh& m, double degrees) {
+  const std::vector<Vec3f> normal = face_normals(m);
+  std::vector<bool> crease(m.edges_size(), false);
+  for (Edge e : m.edges()) {
+    if (m.is_boundary(e)) continue;
+    const Vec3d n0 = to_double(normal[m.face(Mesh::halfedge(e, 0)).idx()]);
+    const Vec3d n1 = to_double(normal[m.face(Mesh::halfedge(e, 1)).idx()]);
+    if (sqrnorm(n0) == 0 || sqrnorm(n1) == 0) continue;
+    // atan2 rather than acos: exact near 0 and 180 degrees.
+    crease[e.idx()] = std::atan2(norm(cross(n0, n1)), dot(n0, n1)) * 180.0 / std::numbers::pi > degrees;
+  }
+  return crease;
+}
+
+//! After a split step: the two halves of a crease stay creases; interior edges are new and smooth.
+std::vector<bool> split_creases(const std::vector<bool>& crease, std::size_t edges_after) {
+  std::vector<bool> next(edges_after, false);
+  for (std::size_t e = 0; e < crease.size(); ++e) next[2 * e] = next[2 * e + 1] = crease[e];
+  return next;
+}
+
+//! `crease`: per edge of m, empty for none (then the rules are exactly the crease-free ones).
+Mesh split_step(const Mesh& m, SubdivisionScheme scheme, const std::vector<bool>& crease, unsigned threads,
+                Progress& progress, double from, double to) {
   const Index V = Index(m.vertices_size()), E = Index(m.edges_size()), F = Index(m.faces_size());
   const Index H = 2 * E;
   const SplitPlan plan = plan_split(m, scheme);
@@ -478,7 +503,7 @@ Mesh split_step(const Mesh& m, SubdivisionScheme scheme, unsigned threads, Progr
     }
     const Halfedge h0 = Mesh::halfedge(Edge(k), 0), h1 = Mesh::halfedge(Edge(k), 1);
     const Index a = m.to_vertex(h0).idx(), b = m.to_vertex(h1).idx();
-    if (scheme == SubdivisionScheme::midpoint || m.is_boundary(Edge(k))) {
+    if (scheme == SubdivisionScheme::midpoint || m.is_boundary(Edge(k)) || (!crease.empty() && crease[k])) {
       s.add(a, 0.5f);
       s.add(b, 0.5f);
     } else if (scheme == SubdivisionScheme::loop) {
@@ -498,6 +523,28 @@ Mesh split_step(const Mesh& m, SubdivisionScheme scheme, unsigned threads, Progr
     if (scheme == SubdivisionScheme::midpoint || !out_h.is_valid()) {
       s.add(v.idx(), 1.0f);
       return;
+    }
+    if (!crease.empty()) {
+      // Hoppe et al. 1994 / DeRose et al. 1998, boundary edges counting as creases: a corner
+      // (3 or more) stays, two interior creases give the curve rule along them, a dart (one)
+      // falls through to the smooth rule, a plain boundary vertex to the boundary rule.
+      Index ends[2] = {kInvalidIndex, kInvalidIndex};
+      int sharp = 0;
+      for (Halfedge h : m.outgoing(v))
+        if (m.is_boundary(Mesh::edge(h)) || crease[Mesh::edge(h).idx()]) {
+          if (sharp < 2) ends[sharp] = m.to_vertex(h).idx();
+          ++sharp;
+        }
+      if (sharp >= 3) {
+        s.add(v.idx(), 1.0f);
+        return;
+      }
+      if (sharp == 2 && !m.is_boundary(out_h)) {
+        s.add(v.idx(), 0.75f);
+        s.add(ends[0], 0.125f);
+        s.add(ends[1], 0.125f);
+        return;
+      }
     }
     if (m.is_boundary(out_h)) {
       // Cubic B-spline on the boundary curve: the two boundary neighbours 1/8 each.
@@ -995,6 +1042,12 @@ std::size_t subdivided_face_count(const Mesh& mesh, const SubdivideOptions& opti
 SubdivideReport subdivide(Mesh& mesh, const SubdivideOptions& options, Progress& progress) {
   const char* name = subdivision_scheme_name(options.scheme);
   if (options.iterations < 1) throw Error("subdivide: iterations must be 1 or more");
+  if (!(options.crease_angle >= 0 && options.crease_angle <= 180))
+    throw Error("subdivide: crease_angle must be from 0 to 180 degrees");
+  // √3 flips every interior edge and trisects only real boundaries: creases would need
+  // connectivity of their own there.
+  if (options.scheme == SubdivisionScheme::sqrt3 && options.crease_angle < 180)
+    throw Error("subdivide: crease_angle is not supported by the sqrt3 scheme yet; use loop or catmull_clark");
   const bool triangles_only = options.scheme == SubdivisionScheme::loop || options.scheme == SubdivisionScheme::sqrt3;
   const FaceCensus census = face_census(mesh);
   if (triangles_only) {
@@ -1019,14 +1072,24 @@ SubdivideReport subdivide(Mesh& mesh, const SubdivideOptions& options, Progress&
     compacted.garbage_collect();
     current = &compacted;
   }
+  // Creases are found once, on the input; later steps carry them to the halves of their edges.
+  // (midpoint's rules are linear before they look at creases: found only for the report.)
+  std::vector<bool> crease;
+  std::size_t crease_edges = 0;
+  if (options.crease_angle < 180) {
+    crease = detect_creases(*current, options.crease_angle);
+    crease_edges = std::size_t(std::count(crease.begin(), crease.end(), true));
+    if (crease_edges == 0) crease.clear();
+  }
   Mesh result;
   for (int it = 0; it < options.iterations; ++it) {
     const double from = double(it) / options.iterations, to = double(it + 1) / options.iterations;
     progress.update(from, "subdividing: step " + std::to_string(it + 1) + " of " + std::to_string(options.iterations));
     Mesh next = options.scheme == SubdivisionScheme::sqrt3
                     ? sqrt3_step(*current, it % 2 == 1, options.threads, progress, from, to)
-                    : split_step(*current, options.scheme, options.threads, progress, from, to);
+                    : split_step(*current, options.scheme, crease, options.threads, progress, from, to);
     if (options.scheme != SubdivisionScheme::sqrt3) weld_split_edge_points(*current, next);
+    if (!crease.empty()) crease = split_creases(crease, next.edges_size());
     result = std::move(next);
     current = &result;
   }
@@ -1039,6 +1102,7 @@ SubdivideReport subdivide(Mesh& mesh, const SubdivideOptions& options, Progress&
   report.edges = mesh.n_edges();
   report.faces = mesh.n_faces();
   report.iterations = options.iterations;
+  report.crease_edges = crease_edges;
   return report;
 }
 
@@ -1056,6 +1120,9 @@ Operation subdivide_operation() {
       "loop and sqrt3 refuse meshes with polygons: run Triangulate first. Boundaries: loop and catmull_clark "
       "refine boundary curves with the cubic B-spline rule; sqrt3 follows Kobbelt's rule, cutting boundary edges "
       "in three on every second iteration of a run (use an even number of iterations on open meshes). "
+      "Creases: with a crease angle below 180, edges where the surface bends more sharply stay sharp under loop "
+      "and catmull_clark (Hoppe et al. 1994; DeRose et al. 1998): they are refined as curves and the corners "
+      "where three or more meet stay put; sqrt3 refuses them, midpoint has no smoothing to undo. "
       "Attributes: vertex attributes are blended with the scheme's own weights, corner attributes (UVs) linearly "
       "inside each old face so seams stay seams, face attributes (materials) are copied to the child faces; normals "
       "are recomputed for the new shape. "
@@ -1066,16 +1133,22 @@ Operation subdivide_operation() {
                         "midpoint to refine without smoothing"),
       ParamSpec::integer("iterations", "Iterations", 1, 1, 6,
                          "refinement steps; each multiplies the face count by 4 (sqrt3: 3)"),
+      ParamSpec::real("crease_angle", "Crease angle", 180, 0, 180,
+                      "degrees: edges where the two faces' normals differ by more than this stay sharp (creases "
+                      "and corners, e.g. a cube's edges at 60); 180 smooths everything. loop and catmull_clark "
+                      "only: sqrt3 refuses values below 180"),
   };
   op.run = [](Mesh& mesh, const ParamValues& values, Progress& progress) {
     SubdivideOptions options;
     options.scheme = subdivision_scheme_from_name(values.get_choice("scheme"));
     options.iterations = int(values.get_int("iterations"));
+    options.crease_angle = values.get_real("crease_angle");
     const std::size_t faces_before = mesh.n_faces();
     SubdivideReport r = subdivide(mesh, options, progress);
     OperationReport report;
     report.add("scheme", std::string(subdivision_scheme_name(options.scheme)));
     report.add("iterations", std::int64_t(r.iterations));
+    if (options.crease_angle < 180) report.add("crease_edges", std::int64_t(r.crease_edges));
     report.add("faces_before", std::int64_t(faces_before));
     report.add("vertices", std::int64_t(r.vertices));
     report.add("edges", std::int64_t(r.edges));
