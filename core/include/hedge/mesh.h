@@ -198,6 +198,16 @@ class Mesh {
   //! True when some edge of f lies on the boundary.
   bool is_boundary(Face f) const;
   bool is_isolated(Vertex v) const { return !halfedge(v).is_valid(); }
+  //! Hints that h's connectivity is about to be read (starts loading it into cache); changes
+  //! nothing. Precondition: h is valid.
+  void prefetch(Halfedge h) const { __builtin_prefetch(&halfedges_[h.idx()]); }
+  //! The same for f's half-edge.
+  void prefetch(Face f) const { __builtin_prefetch(&face_halfedge_[f.idx()]); }
+  //! The same for v's outgoing half-edge and position.
+  void prefetch(Vertex v) const {
+    __builtin_prefetch(&vertex_halfedge_[v.idx()]);
+    __builtin_prefetch(&positions_[v.idx()]);
+  }
 
   //! Number of edges at v / corners of f.
   std::size_t valence(Vertex v) const;
