@@ -3,6 +3,7 @@
 #include "hedge/decimate.h"
 
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <cmath>
 #include <cstring>
@@ -399,38 +400,56 @@ void Decimator::compute_frame() {
 }
 
 void Decimator::compute_quadrics() {
-  vd_.assign(m_.vertices_size(), VertexData());
-  for (Vertex v : m_.vertices()) vd_[v.idx()].position = to_float(local(v));
-  std::vector<Quadric> sum(m_.vertices_size());
-  // Face planes weighted by area, so that a region's error does not depend on how finely
-  // it happens to be tessellated.
-  for (Face f : m_.faces()) {
-    const Halfedge h = m_.halfedge(f);
-    const Vertex a = m_.to_vertex(h), b = m_.to_vertex(m_.next(h)), c = m_.to_vertex(m_.prev(h));
-    const Vec3d pa = at(a), pb = at(b), pc = at(c);
-    Vec3d n = cross(pb - pa, pc - pa);
-    const double len = norm(n);
-    if (!(len > 0)) continue;
-    n /= len;
-    for (Vertex v : {a, b, c}) sum[v.idx()].add_plane(n, dot(n, at(v) - pa), 0.5 * len);
-  }
-  for (Edge e : m_.edges()) {
-    Halfedge h = Mesh::halfedge(e, 0);
-    if (!m_.is_boundary(h)) h = Mesh::opposite(h);
-    if (!m_.is_boundary(h)) continue;
-    has_boundary_ = true;
-    const Halfedge inner = Mesh::opposite(h);
-    const Vertex a = m_.from_vertex(inner), b = m_.to_vertex(inner), c = m_.to_vertex(m_.next(inner));
-    const Vec3d pa = at(a), pb = at(b), pc = at(c);
-    const Vec3d along = pb - pa;
-    const Vec3d face_normal = cross(along, pc - pa);
-    Vec3d n = cross(along, face_normal);
-    const double len = norm(n);
-    if (!(len > 0)) continue;
-    n /= len;
-    for (Vertex v : {a, b}) sum[v.idx()].add_plane(n, dot(n, at(v) - pa), kBoundaryWeight * sqrnorm(along));
-  }
-  for (Vertex v : m_.vertices()) vd_[v.idx()].quadric.store(sum[v.idx()]);
+  const std::size_t n = m_.vertices_size();
+  vd_.assign(n, VertexData());
+  parallel_for(n, opt_.threads, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i)
+      if (const Vertex v(static_cast<Index>(i)); !m_.is_deleted(v)) vd_[i].position = to_float(local(v));
+  });
+  // Each thread sums the planes at the vertices of its own index range, scanning every face
+  // and boundary edge in order: a vertex receives its planes in the same order, so the same
+  // bits, for any number of threads. A face with corners in two ranges is measured twice;
+  // in a mesh's usual vertex order few are.
+  std::atomic<bool> has_boundary{false};
+  parallel_for(n, opt_.threads, [&](std::size_t begin, std::size_t end) {
+    std::vector<Quadric> sum(end - begin);
+    auto mine = [&](Vertex v) { return v.idx() - begin < end - begin; };
+    // Face planes weighted by area, so that a region's error does not depend on how finely
+    // it happens to be tessellated.
+    for (Face f : m_.faces()) {
+      const Halfedge h = m_.halfedge(f);
+      const Vertex a = m_.to_vertex(h), b = m_.to_vertex(m_.next(h)), c = m_.to_vertex(m_.prev(h));
+      if (!mine(a) && !mine(b) && !mine(c)) continue;
+      const Vec3d pa = at(a), pb = at(b), pc = at(c);
+      Vec3d normal = cross(pb - pa, pc - pa);
+      const double len = norm(normal);
+      if (!(len > 0)) continue;
+      normal /= len;
+      for (Vertex v : {a, b, c})
+        if (mine(v)) sum[v.idx() - begin].add_plane(normal, dot(normal, at(v) - pa), 0.5 * len);
+    }
+    for (Edge e : m_.edges()) {
+      Halfedge h = Mesh::halfedge(e, 0);
+      if (!m_.is_boundary(h)) h = Mesh::opposite(h);
+      if (!m_.is_boundary(h)) continue;
+      has_boundary.store(true, std::memory_order_relaxed);
+      const Halfedge inner = Mesh::opposite(h);
+      const Vertex a = m_.from_vertex(inner), b = m_.to_vertex(inner), c = m_.to_vertex(m_.next(inner));
+      if (!mine(a) && !mine(b)) continue;
+      const Vec3d pa = at(a), pb = at(b), pc = at(c);
+      const Vec3d along = pb - pa;
+      const Vec3d face_normal = cross(along, pc - pa);
+      Vec3d normal = cross(along, face_normal);
+      const double len = norm(normal);
+      if (!(len > 0)) continue;
+      normal /= len;
+      for (Vertex v : {a, b})
+        if (mine(v)) sum[v.idx() - begin].add_plane(normal, dot(normal, at(v) - pa), kBoundaryWeight * sqrnorm(along));
+    }
+    for (std::size_t i = begin; i < end; ++i)
+      if (!m_.is_deleted(Vertex(static_cast<Index>(i)))) vd_[i].quadric.store(sum[i - begin]);
+  });
+  has_boundary_ = has_boundary.load();
 }
 
 void Decimator::find_corner_channels() {
