@@ -450,6 +450,27 @@ TEST(FillHoles, LoneTriangleIsNotDoubled) {
   EXPECT_EQ(mesh.n_faces(), 1u);
 }
 
+TEST(FillHoles, BorderVertexWithoutEdgeLengthGetsNoFan) {
+  // Found by fuzz_euler: border vertices all of whose edges have zero length asked for
+  // triangles of no size, so refinement fanned hundreds of slivers into them and the fan
+  // made the fairing system dense (seconds of solving for a hole of six edges). The mesh
+  // as the fuzzer left it: six vertices at two points, a pentagon and a triangle.
+  const Point p{{-3, -2, -2}}, q{{1, -2, -1}};
+  Soup soup;
+  soup.positions = {p, q, p, p, p, q};
+  soup.add_face({0, 2, 1, 4, 3});
+  soup.add_face({1, 5, 4});
+  Mesh mesh = build(soup).mesh;
+  FillHolesReport r = fill_holes(mesh);
+  ASSERT_VALID(mesh);
+  EXPECT_EQ(r.holes_filled, 1u);
+  EXPECT_TRUE(watertight(mesh));
+  EXPECT_LT(r.vertices_added, 60u);
+  std::size_t max_valence = 0;
+  for (Vertex v : mesh.vertices()) max_valence = std::max(max_valence, mesh.valence(v));
+  EXPECT_LE(max_valence, 24u);
+}
+
 TEST(FillHoles, CancelLeavesTheMeshAsItWas) {
   Mesh mesh = build(sphere_with_hole(32, 50)).mesh;
   const std::size_t faces = mesh.n_faces(), vertices = mesh.n_vertices();

@@ -235,6 +235,13 @@ void HoleFiller::fill(Halfedge start, double fraction) {
                   corner_values_[k].stride());
     slot_[v.idx()] = slot;
   }
+  // A border vertex whose edges have (almost) no length would ask for triangles of no size:
+  // refinement would fan ever smaller triangles into it up to the vertex cap, and the fan
+  // makes the fairing system dense. Its density is kept within a tenth of the border's mean.
+  double mean_sigma = 0;
+  for (Vertex v : border_) mean_sigma += sigma_[v.idx()];
+  mean_sigma /= double(border_.size());
+  for (Vertex v : border_) sigma_[v.idx()] = std::max(sigma_[v.idx()], 0.1 * mean_sigma);
 
   Face f = mesh_.fill_hole(loop_.front());
   add_patch_face(f);
