@@ -175,6 +175,8 @@ std::vector<Case> cases() {
   }
   out.push_back({"bunny.off", "subdivide", {{"scheme", "loop"}, {"iterations", "3"}}});
   out.push_back({"bunny.off", "subdivide", {{"scheme", "catmull_clark"}, {"iterations", "2"}}});
+  out.push_back({"bunny.off", "subdivide", {{"scheme", "loop"}, {"iterations", "2"}, {"crease_angle", "30"}}});
+  out.push_back({"bunny.off", "subdivide", {{"scheme", "catmull_clark"}, {"crease_angle", "30"}}});
   return out;
 }
 
