@@ -181,7 +181,8 @@ class EdgeQueue {
       std::vector<Entry>& from = buckets_[i];
       std::size_t live = 0;
       // The versions of a bucket's edges are scattered over the array: fetch them ahead.
-      constexpr std::size_t kAhead = 16;
+      constexpr std::size_t kAhead = 64;
+      for (std::size_t j = 0; j < std::min(kAhead, from.size()); ++j) __builtin_prefetch(&(*versions_)[from[j].edge]);
       for (std::size_t j = 0; j < from.size(); ++j) {
         if (j + kAhead < from.size()) __builtin_prefetch(&(*versions_)[from[j + kAhead].edge]);
         if ((*versions_)[from[j].edge] == version(from[j].key)) from[live++] = from[j];
@@ -628,53 +629,45 @@ bool Decimator::evaluate(Edge e, Candidate& c) const {
 
 // The current collapse may change the neighbourhood being fetched between two steps; the
 // records of deleted elements keep in-range indices, so such a walk only reads stale values
-// (and fetches the wrong lines). Only a deleted vertex's half-edge becomes invalid.
+// (and fetches the wrong lines), and it stops after 20 steps whatever it finds.
 void Decimator::fetch_ahead() {
+  if (ahead_stage_ == 0) return;
   const Halfedge h0 = Mesh::halfedge(ahead_edge_, 0), o0 = Mesh::opposite(h0);
-  switch (ahead_stage_) {
-    case 0:
-      return;
-    case 1: {  // the ends and the triangles' other half-edges
-      for (Halfedge x : {h0, o0}) {
-        const Vertex v = m_.to_vertex(x);
-        __builtin_prefetch(&vd_[v.idx()]);
-        m_.prefetch(v);
-        if (const Face f = m_.face(x); f.is_valid()) m_.prefetch(f), m_.prefetch(m_.next(x)), m_.prefetch(m_.prev(x));
-      }
-      ahead_stage_ = 2;
-      return;
+  if (ahead_stage_ == 1) {
+    // The ends and the triangles' other half-edges and faces. The rings start from the
+    // edge's own half-edges (each is outgoing from one end), not from halfedge(v), which
+    // would be one more load to wait for.
+    for (int i = 0; i < 2; ++i) {
+      const Halfedge x = i == 0 ? h0 : o0;
+      const Vertex v = m_.to_vertex(x);
+      __builtin_prefetch(&vd_[v.idx()]);
+      m_.prefetch(v);
+      if (const Face f = m_.face(x); f.is_valid()) m_.prefetch(f), m_.prefetch(m_.next(x)), m_.prefetch(m_.prev(x));
+      ahead_ring_[i] = ahead_ring_start_[i] = x;
     }
-    case 2: {  // the opposite corners and the first step of both rings
-      for (Halfedge x : {h0, o0})
-        if (m_.face(x).is_valid()) __builtin_prefetch(&vd_[m_.to_vertex(m_.next(x)).idx()]);
-      for (int i = 0; i < 2; ++i) {
-        const Halfedge start = m_.halfedge(m_.to_vertex(i == 0 ? o0 : h0));
-        ahead_ring_[i] = ahead_ring_start_[i] = start;
-        if (start.is_valid()) m_.prefetch(start);
-      }
-      ahead_stage_ = 3;
-      return;
-    }
-    default: {  // one more step around both rings
-      bool more = false;
-      for (int i = 0; i < 2; ++i) {
-        Halfedge& x = ahead_ring_[i];
-        if (!x.is_valid()) continue;
-        const Vertex w = m_.to_vertex(x);
-        __builtin_prefetch(&m_.position(w));
-        __builtin_prefetch(&vd_[w.idx()]);
-        __builtin_prefetch(&version_[Mesh::edge(x).idx()]);
-        x = m_.ccw_rotated(x);
-        if (x == ahead_ring_start_[i] || !x.is_valid()) {
-          x = Halfedge();
-          continue;
-        }
-        m_.prefetch(x);
-        more = true;
-      }
-      ahead_stage_ = more && ahead_stage_ < 20 ? ahead_stage_ + 1 : 0;
-    }
+  } else if (ahead_stage_ == 2) {
+    // The opposite corners, from the half-edges stage 1 fetched.
+    for (Halfedge x : {h0, o0})
+      if (m_.face(x).is_valid()) __builtin_prefetch(&vd_[m_.to_vertex(m_.next(x)).idx()]);
   }
+  // One step around both rings: the neighbour's data, and the next half-edge's record.
+  bool more = false;
+  for (int i = 0; i < 2; ++i) {
+    Halfedge& x = ahead_ring_[i];
+    if (!x.is_valid()) continue;
+    const Vertex w = m_.to_vertex(x);
+    __builtin_prefetch(&m_.position(w));
+    __builtin_prefetch(&vd_[w.idx()]);
+    __builtin_prefetch(&version_[Mesh::edge(x).idx()]);
+    x = m_.ccw_rotated(x);
+    if (x == ahead_ring_start_[i]) {
+      x = Halfedge();
+      continue;
+    }
+    m_.prefetch(x);
+    more = true;
+  }
+  ahead_stage_ = more && ahead_stage_ < 20 ? ahead_stage_ + 1 : 0;
 }
 
 void Decimator::fill_heap() {
@@ -686,7 +679,11 @@ void Decimator::fill_heap() {
   constexpr std::uint32_t kNone = 0xffffffffu;  // above every key of a finite cost
   std::vector<std::uint32_t> keys(n);
   parallel_for(n, opt_.threads, [&](std::size_t begin, std::size_t end) {
+    constexpr std::size_t kAhead = 8;  // edges: the half-edges stream in, the end vertices do not
     for (std::size_t i = begin; i < end; ++i) {
+      if (i + kAhead < end)
+        for (unsigned side = 0; side < 2; ++side)
+          __builtin_prefetch(&vd_[m_.vertex(Edge(static_cast<Index>(i + kAhead)), side).idx()]);
       const Edge e(static_cast<Index>(i));
       Candidate c;
       keys[i] = !m_.is_deleted(e) && evaluate(e, c) ? EdgeQueue::key(c.cost, 0) : kNone;
@@ -1013,6 +1010,7 @@ void Decimator::collapse(Halfedge h, const Candidate& c) {
   // which kValenceLeft/Right refuse), so the mesh's own test, which costs as much as the
   // collapse, is not run again.
   m_.collapse_unchecked(h);
+  fetch_ahead();
   // Queue entries of deleted edges go stale.
   for (Edge d : doomed)
     if (m_.is_deleted(d)) ++version_[d.idx()];
