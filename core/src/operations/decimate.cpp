@@ -337,7 +337,9 @@ class Decimator {
     std::uint16_t valence = 0;
     std::uint8_t flags = 0;
   };
-  std::vector<VertexData> vd_;
+  // Left unset by resize(): compute_quadrics() writes every element on its threads, which
+  // then take the page faults of first touching the array instead of one zero-filling thread.
+  std::vector<VertexData, detail::UnsetAllocator<VertexData>> vd_;
   std::vector<std::uint8_t> version_;  // of each edge's current queue entry: one byte, stays in cache
   EdgeQueue queue_{&version_};
   struct RingEntry {
@@ -402,10 +404,13 @@ void Decimator::compute_frame() {
 
 void Decimator::compute_quadrics() {
   const std::size_t n = m_.vertices_size();
-  vd_.assign(n, VertexData());
+  vd_.clear();
+  vd_.resize(n);
   parallel_for(n, opt_.threads, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i)
+    for (std::size_t i = begin; i < end; ++i) {
+      vd_[i] = VertexData();
       if (const Vertex v(static_cast<Index>(i)); !m_.is_deleted(v)) vd_[i].position = to_float(local(v));
+    }
   });
   // Each thread sums the planes at the vertices of its own index range, scanning every face
   // and boundary edge in order: a vertex receives its planes in the same order, so the same
@@ -494,15 +499,19 @@ std::uint8_t Decimator::classify(Vertex v) const {
 }
 
 void Decimator::classify_vertices() {
-  for (Halfedge h : m_.halfedges()) {
-    auto& n = vd_[m_.from_vertex(h).idx()].valence;
-    if (n < std::numeric_limits<std::uint16_t>::max()) ++n;
-  }
-  for (Vertex v : m_.vertices()) {
-    std::uint8_t f = m_.is_boundary(v) ? kBoundary : 0;
-    if (seam_mode_) f |= classify(v);
-    vd_[v.idx()].flags = f;
-  }
+  parallel_for(m_.vertices_size(), opt_.threads, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      const Vertex v(static_cast<Index>(i));
+      if (m_.is_deleted(v)) continue;
+      std::size_t valence = 0;
+      for ([[maybe_unused]] Halfedge h : m_.outgoing(v)) ++valence;
+      vd_[i].valence =
+          static_cast<std::uint16_t>(std::min<std::size_t>(valence, std::numeric_limits<std::uint16_t>::max()));
+      std::uint8_t f = m_.is_boundary(v) ? kBoundary : 0;
+      if (seam_mode_) f |= classify(v);
+      vd_[i].flags = f;
+    }
+  });
 }
 
 namespace {
