@@ -503,10 +503,8 @@ void Decimator::classify_vertices() {
     for (std::size_t i = begin; i < end; ++i) {
       const Vertex v(static_cast<Index>(i));
       if (m_.is_deleted(v)) continue;
-      std::size_t valence = 0;
-      for ([[maybe_unused]] Halfedge h : m_.outgoing(v)) ++valence;
       vd_[i].valence =
-          static_cast<std::uint16_t>(std::min<std::size_t>(valence, std::numeric_limits<std::uint16_t>::max()));
+          static_cast<std::uint16_t>(std::min<std::size_t>(m_.valence(v), std::numeric_limits<std::uint16_t>::max()));
       std::uint8_t f = m_.is_boundary(v) ? kBoundary : 0;
       if (seam_mode_) f |= classify(v);
       vd_[i].flags = f;
