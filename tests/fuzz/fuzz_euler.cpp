@@ -14,6 +14,7 @@
 #include "fuzz_common.h"
 #include "hedge/catalogue.h"
 #include "hedge/mesh.h"
+#include "hedge/report.h"
 
 namespace {
 
@@ -152,23 +153,13 @@ hedge::ParamValues draw_params(FuzzedDataProvider& in, const hedge::Operation& o
 }
 
 //! Triangles remesh would aim at: the area over equilateral triangles of the finest edge it
-//! may ask for (adaptive sizing goes down to a quarter of the target).
+//! may ask for (adaptive sizing goes down to a quarter of the target), as remesh forecasts.
 double remesh_forecast(const Mesh& mesh, const hedge::ParamValues& params) {
-  double area = 0, edges = 0;
-  std::size_t n_edges = 0;
-  for (Face f : mesh.faces()) {
-    Halfedge h0 = mesh.halfedge(f);
-    hedge::Vec3d p0 = hedge::to_double(mesh.position(mesh.from_vertex(h0)));
-    for (Halfedge h = mesh.next(h0); mesh.next(h) != h0; h = mesh.next(h))
-      area += 0.5 * hedge::norm(hedge::cross(hedge::to_double(mesh.position(mesh.from_vertex(h))) - p0,
-                                             hedge::to_double(mesh.position(mesh.to_vertex(h))) - p0));
-  }
-  for (Edge e : mesh.edges())
-    edges += hedge::distance(mesh.position(mesh.vertex(e, 0)), mesh.position(mesh.vertex(e, 1))), ++n_edges;
+  const hedge::MeshStatistics stats = hedge::mesh_statistics(mesh);
   double length = params.get_real("target_edge_length");
-  if (length == 0 && n_edges) length = edges / double(n_edges);
+  if (length == 0) length = stats.edge_length_mean;
   if (params.get_bool("adaptive")) length *= 0.25;
-  return length > 0 ? area / (std::sqrt(3.0) / 4 * length * length) : 0;
+  return length > 0 ? stats.area / (std::sqrt(3.0) / 4 * length * length) : 0;
 }
 
 void run_catalogue(FuzzedDataProvider& in, Mesh& mesh) {
