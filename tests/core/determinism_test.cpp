@@ -177,6 +177,8 @@ std::vector<Case> cases() {
   out.push_back({"bunny.off", "subdivide", {{"scheme", "catmull_clark"}, {"iterations", "2"}}});
   out.push_back({"bunny.off", "subdivide", {{"scheme", "loop"}, {"iterations", "2"}, {"crease_angle", "30"}}});
   out.push_back({"bunny.off", "subdivide", {{"scheme", "catmull_clark"}, {"crease_angle", "30"}}});
+  // Boundaries, seams of split non-manifold edges and creases, all cut by the second step.
+  out.push_back({"dragon_res3.ply", "subdivide", {{"scheme", "sqrt3"}, {"iterations", "2"}, {"crease_angle", "30"}}});
   return out;
 }
 

@@ -698,19 +698,24 @@ std::size_t on_unit_cube(const Mesh& m) {
 // Every cube edge (90 degrees) is a crease at 60 and every corner has three: the corners stay,
 // the edges refine as straight lines, the flat sides stay flat.
 TEST(SubdivideCreases, CreasedCubeStaysTheCube) {
-  for (auto s : {SubdivisionScheme::catmull_clark, SubdivisionScheme::loop}) {
-    const Mesh before = s == SubdivisionScheme::loop ? triangulated_cube() : unit_cube();
-    for (int iterations : {1, 3}) {
+  for (auto s : {SubdivisionScheme::catmull_clark, SubdivisionScheme::loop, SubdivisionScheme::sqrt3}) {
+    const bool sqrt3 = s == SubdivisionScheme::sqrt3;
+    const Mesh before = s == SubdivisionScheme::catmull_clark ? unit_cube() : triangulated_cube();
+    for (int iterations : sqrt3 ? std::vector<int>{1, 2, 4} : std::vector<int>{1, 3}) {
       Mesh mesh = before;
-      const SubdivideReport r = subdivide(mesh, creased(s, 60, iterations));
+      const SubdivideOptions options = creased(s, 60, iterations);
+      const SubdivideReport r = subdivide(mesh, options);
       expect_valid(mesh);
       EXPECT_EQ(r.crease_edges, 12u) << subdivision_scheme_name(s);  // not the triangulation's diagonals
+      EXPECT_EQ(subdivided_face_count(before, options), mesh.n_faces()) << subdivision_scheme_name(s);
       for (Index v = 0; v < 8; ++v) EXPECT_EQ(mesh.position(Vertex(v)), before.position(Vertex(v)));
-      // Each cube edge is cut into 2^iterations pieces: its inner points and the 8 corners.
-      const std::size_t pieces = std::size_t(1) << iterations;
+      // Each cube edge is cut into 2^iterations pieces (sqrt3: 3 every second step): its
+      // inner points and the 8 corners.
+      std::size_t pieces = sqrt3 ? 1 : std::size_t(1) << iterations;
+      for (int it = 1; sqrt3 && it < iterations; it += 2) pieces *= 3;
       EXPECT_EQ(on_unit_cube(mesh), 8 + 12 * (pieces - 1)) << subdivision_scheme_name(s) << " x" << iterations;
       // The first step puts the points of the cube's edges at their midpoints.
-      if (iterations == 1)
+      if (iterations == 1 && !sqrt3)
         for (Edge e : before.edges()) {
           const Vec3d mid = (at(before, before.vertex(e, 0).idx()) + at(before, before.vertex(e, 1).idx())) * 0.5;
           const int halves = (mid[0] == 0.5) + (mid[1] == 0.5) + (mid[2] == 0.5);
@@ -764,9 +769,70 @@ TEST(SubdivideCreases, HandComputedCreaseRules) {
   expect_point(all.position(Vertex(4 + e01.idx())), {{0.5, 0, 0}});
 }
 
+//! The first vertex at `want`, invalid when there is none.
+Vertex find_point(const Mesh& m, const Vec3d& want, double tolerance = 1e-6) {
+  for (Vertex v : m.vertices())
+    if (norm(at(m, v.idx()) - want) < tolerance) return v;
+  return Vertex();
+}
+
+bool has_point(const Mesh& m, const Vec3d& want) { return find_point(m, want).is_valid(); }
+
+// The same tetrahedron under sqrt3 at 100 degrees: the slanted face's edges 1-2, 2-3, 3-1 are
+// creases, kept through the first step (the edges at vertex 0 are flipped) and cut in three by
+// the second with Kobbelt's boundary stencils, as if the triangle 1-2-3 were a boundary.
+TEST(SubdivideCreases, Sqrt3CreasesFollowTheBoundaryRules) {
+  const Mesh before = tetrahedron();
+  Mesh once = before;
+  EXPECT_EQ(subdivide(once, creased(SubdivisionScheme::sqrt3, 100)).crease_edges, 3u);
+  expect_valid(once);
+  EXPECT_EQ(once.n_faces(), 12u);
+  // Vertex 0 smooth: 4/9 itself, 5/27 each neighbour; the crease vertices wait.
+  expect_point(once.position(Vertex(0)), {{5.0 / 27, 5.0 / 27, 5.0 / 27}});
+  for (Index v = 1; v < 4; ++v) EXPECT_EQ(once.position(Vertex(v)), before.position(Vertex(v)));
+  for (Index a = 1; a < 4; ++a) {
+    EXPECT_FALSE(once.find_edge(Vertex(0), Vertex(a)).is_valid()) << a;  // flipped
+    for (Index b = a + 1; b < 4; ++b) EXPECT_TRUE(once.find_edge(Vertex(a), Vertex(b)).is_valid()) << a << b;
+  }
+
+  Mesh twice = before;
+  const SubdivideOptions two = creased(SubdivisionScheme::sqrt3, 100, 2);
+  subdivide(twice, two);
+  expect_valid(twice);
+  // 3 x 12 triangles, and each crease cut in three adds two triangles on either side.
+  EXPECT_EQ(twice.n_faces(), 36u + 3 * 4);
+  EXPECT_EQ(subdivided_face_count(before, two), twice.n_faces());
+  // Vertex 1 on the curve 2-1-3: (4, 19, 4) / 27.
+  expect_point(twice.position(Vertex(1)), {{19.0 / 27, 4.0 / 27, 4.0 / 27}});
+  // On crease 1-2, from vertex 1: (3 + 16 x 1 + 10 x 2) / 27; from vertex 2: (3 + 16 x 2 + 10 x 1) / 27.
+  EXPECT_TRUE(has_point(twice, {{16.0 / 27, 10.0 / 27, 1.0 / 27}}));
+  EXPECT_TRUE(has_point(twice, {{10.0 / 27, 16.0 / 27, 1.0 / 27}}));
+  // The creases' 9 pieces join the curve's 9 points in one loop: each crease vertex, then the
+  // points a third and two thirds on towards the next (in 27ths).
+  const Vec3d loop[9] = {{{19, 4, 4}},  {{16, 10, 1}}, {{10, 16, 1}}, {{4, 19, 4}}, {{1, 16, 10}},
+                         {{1, 10, 16}}, {{4, 4, 19}},  {{10, 1, 16}}, {{16, 1, 10}}};
+  std::vector<Vertex> curve;
+  for (const Vec3d& p : loop) {
+    curve.push_back(find_point(twice, p / 27.0));
+    ASSERT_TRUE(curve.back().is_valid()) << p[0] << " " << p[1] << " " << p[2];
+  }
+  for (std::size_t i = 0; i < 9; ++i)
+    EXPECT_TRUE(twice.find_edge(curve[i], curve[(i + 1) % 9]).is_valid()) << "piece " << i;
+
+  // At 60 every edge is a crease and every vertex a corner: the corners stay, the pieces of
+  // each edge are its thirds.
+  Mesh all = before;
+  EXPECT_EQ(subdivide(all, creased(SubdivisionScheme::sqrt3, 60, 2)).crease_edges, 6u);
+  expect_valid(all);
+  for (Index v = 0; v < 4; ++v) EXPECT_EQ(all.position(Vertex(v)), before.position(Vertex(v)));
+  EXPECT_TRUE(has_point(all, {{1.0 / 3, 0, 0}}));
+  EXPECT_TRUE(has_point(all, {{2.0 / 3, 0, 0}}));
+  EXPECT_TRUE(has_point(all, {{0, 1.0 / 3, 2.0 / 3}}));
+}
+
 // Default and 180 are the crease-free rules, bit for bit, and so is an angle no edge exceeds.
 TEST(SubdivideCreases, NoCreaseIsTheOldResult) {
-  for (auto s : {SubdivisionScheme::loop, SubdivisionScheme::catmull_clark}) {
+  for (auto s : {SubdivisionScheme::loop, SubdivisionScheme::catmull_clark, SubdivisionScheme::sqrt3}) {
     Mesh reference = tetrahedron();
     subdivide(reference, scheme(s, 2));
     for (double angle : {180.0, 130.0}) {
@@ -799,12 +865,19 @@ Mesh dart_fan() {
   return make_mesh(p, f);
 }
 
+//! The smooth rules of Loop and sqrt3 both keep 1 - t of the vertex and give t / n to each of
+//! its n neighbours.
+Vec3d ring_rule(const Mesh& m, Vertex v, double t) {
+  const double n = double(m.valence(v));
+  Vec3d want = at(m, v.idx()) * (1 - t);
+  for (Vertex w : m.vertices(v)) want += at(m, w.idx()) * (t / n);
+  return want;
+}
+
 Vec3d loop_smooth(const Mesh& m, Vertex v) {
   const double n = double(m.valence(v));
   const double c = 3.0 / 8.0 + 0.25 * std::cos(2.0 * std::numbers::pi / n), beta = (5.0 / 8.0 - c * c) / n;
-  Vec3d want = at(m, v.idx()) * (1 - n * beta);
-  for (Vertex w : m.vertices(v)) want += at(m, w.idx()) * beta;
-  return want;
+  return ring_rule(m, v, n * beta);
 }
 
 TEST(SubdivideCreases, DartIsSmoothCornerIsFixed) {
@@ -839,6 +912,31 @@ TEST(SubdivideCreases, DartIsSmoothCornerIsFixed) {
   EXPECT_NE(smooth.position(Vertex(1)), before.position(Vertex(1)));
 }
 
+Vec3d sqrt3_smooth(const Mesh& m, Vertex v) {
+  return ring_rule(m, v, (4 - 2 * std::cos(2 * std::numbers::pi / double(m.valence(v)))) / 9);
+}
+
+// The fan under sqrt3: the dart and the corner end the crease, so when the second step cuts
+// it its two new points are its thirds (the curve rule has no neighbour beyond either end).
+TEST(SubdivideCreases, Sqrt3DartIsSmoothCornerIsFixed) {
+  const Mesh before = dart_fan();
+  Mesh once = before, twice = before;
+  EXPECT_EQ(subdivide(once, creased(SubdivisionScheme::sqrt3, 40)).crease_edges, 1u);
+  subdivide(twice, creased(SubdivisionScheme::sqrt3, 40, 2));
+  expect_valid(once);
+  expect_valid(twice);
+  expect_point(once.position(Vertex(0)), sqrt3_smooth(before, Vertex(0)), 1e-6);  // dart
+  expect_point(twice.position(Vertex(0)), sqrt3_smooth(once, Vertex(0)), 1e-6);
+  EXPECT_EQ(twice.position(Vertex(1)), before.position(Vertex(1)));  // corner
+  ASSERT_TRUE(once.find_edge(Vertex(0), Vertex(1)).is_valid());      // the crease was not flipped
+  EXPECT_FALSE(once.find_edge(Vertex(0), Vertex(2)).is_valid());     // a smooth spoke was
+  expect_point(twice.position(Vertex(2)),  // ring vertex 2: (4, 19, 4) / 27 along the boundary
+               (at(once, 1) * 4 + at(once, 2) * 19 + at(once, 3) * 4) / 27.0, 1e-6);
+  const Vec3d c = at(once, 0), corner = at(once, 1);
+  EXPECT_TRUE(has_point(twice, (c * 2 + corner) / 3.0));
+  EXPECT_TRUE(has_point(twice, (c + corner * 2) / 3.0));
+}
+
 // A sheet folded along x = 2 (z = |x - 2|, a 90 degree ridge) with uv = xy and a vertex
 // colour equal to the position: with the crease the sheet stays two planes, the ridge's
 // ends (boundary corners) stay, and the attributes follow the crease stencils.
@@ -858,11 +956,15 @@ Mesh folded_sheet(bool triangles) {
 }
 
 TEST(SubdivideCreases, FoldStaysAFoldAndCarriesAttributes) {
-  for (auto s : {SubdivisionScheme::loop, SubdivisionScheme::catmull_clark}) {
-    const char* name = subdivision_scheme_name(s);
-    Mesh mesh = folded_sheet(s == SubdivisionScheme::loop);
+  const std::pair<SubdivisionScheme, int> runs[] = {{SubdivisionScheme::loop, 2},
+                                                    {SubdivisionScheme::catmull_clark, 2},
+                                                    {SubdivisionScheme::sqrt3, 2},
+                                                    {SubdivisionScheme::sqrt3, 4}};
+  for (const auto& [s, iterations] : runs) {
+    const std::string name = std::string(subdivision_scheme_name(s)) + " x" + std::to_string(iterations);
+    Mesh mesh = folded_sheet(s != SubdivisionScheme::catmull_clark);
     const std::size_t corners_before = mesh.halfedge_properties().get_channel("uv")->size();
-    EXPECT_EQ(subdivide(mesh, creased(s, 60, 2)).crease_edges, 4u) << name;
+    EXPECT_EQ(subdivide(mesh, creased(s, 60, iterations)).crease_edges, 4u) << name;
     expect_valid(mesh);
     for (Vertex v : mesh.vertices()) {
       const Point& p = mesh.position(v);
@@ -894,25 +996,25 @@ TEST(SubdivideCreases, FoldStaysAFoldAndCarriesAttributes) {
         EXPECT_NEAR(value[1], p[1], 1e-5f) << name;
         ++on_ridge;
       }
-    EXPECT_GT(on_ridge, 16u) << name;  // 17 ridge vertices after two steps, each in 2+ faces
+    // The ridge's vertices after two steps: 17 (loop, catmull_clark), 13 (sqrt3; 37 after
+    // four), each in 2 or more faces.
+    EXPECT_GT(on_ridge, s != SubdivisionScheme::sqrt3 ? 33u : iterations == 2 ? 25u : 73u) << name;
   }
 }
 
 TEST(SubdivideCreases, Refusals) {
   Mesh mesh = tetrahedron();
-  try {
-    subdivide(mesh, creased(SubdivisionScheme::sqrt3, 60));
-    ADD_FAILURE() << "no error";
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("crease_angle is not supported by the sqrt3 scheme"), std::string::npos)
-        << e.what();
-  }
+  for (auto s : {SubdivisionScheme::loop, SubdivisionScheme::sqrt3})
+    for (double bad : {-1.0, 181.0, std::nan("")}) {
+      try {
+        subdivide(mesh, creased(s, bad));
+        ADD_FAILURE() << "no error for " << bad;
+      } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("crease_angle must be from 0 to 180"), std::string::npos) << e.what();
+      }
+    }
   EXPECT_EQ(mesh.n_faces(), 4u);
-  for (double bad : {-1.0, 181.0, std::nan("")})
-    EXPECT_THROW(subdivide(mesh, creased(SubdivisionScheme::loop, bad)), Error);
-  EXPECT_EQ(mesh.n_faces(), 4u);
-  subdivide(mesh, creased(SubdivisionScheme::sqrt3, 180));  // 180: no creases, allowed
-  EXPECT_EQ(mesh.n_faces(), 12u);
+  EXPECT_EQ(mesh.position(Vertex(1)), (Point{{1, 0, 0}}));
   // midpoint is linear: creases change nothing.
   Mesh plain = unit_cube(), with = unit_cube();
   subdivide(plain, scheme(SubdivisionScheme::midpoint));
@@ -989,7 +1091,7 @@ TEST(SubdivideCreases, CreasesAreMeasuredOnceOnTheInput) {
 TEST(SubdivideCreases, SameResultAtEveryThreadCount) {
   const Mesh bunny = load("bunny.off");
   if (bunny.is_empty()) GTEST_SKIP() << "bunny.off not found";
-  for (auto s : {SubdivisionScheme::loop, SubdivisionScheme::catmull_clark}) {
+  for (auto s : {SubdivisionScheme::loop, SubdivisionScheme::catmull_clark, SubdivisionScheme::sqrt3}) {
     Mesh reference;
     for (unsigned threads : {1u, 2u, 3u, 8u}) {
       hedge::testing::set_parallel_grain(64);
@@ -1011,6 +1113,22 @@ TEST(SubdivideCreases, SameResultAtEveryThreadCount) {
           0)
           << subdivision_scheme_name(s) << " at " << threads << " threads";
     }
+  }
+}
+
+// sqrt3 creases on a real scan with 1,271 boundary loops and split non-manifold edges: the
+// creases, boundaries and seams all meet, and the result stays valid, sized as forecast.
+TEST(SubdivideCreases, Sqrt3OnAMessyScan) {
+  const Mesh scan = load("dragon_res3.ply");
+  if (scan.is_empty()) GTEST_SKIP() << "dragon_res3.ply not found";
+  for (int iterations : {2, 3}) {
+    Mesh mesh = scan;
+    const SubdivideOptions options = creased(SubdivisionScheme::sqrt3, 30, iterations);
+    const SubdivideReport r = subdivide(mesh, options);
+    expect_valid(mesh);
+    EXPECT_GT(r.crease_edges, 1000u);
+    EXPECT_EQ(mesh.n_faces(), subdivided_face_count(scan, options));
+    EXPECT_EQ(extract(mesh).n_faces(), mesh.n_faces());
   }
 }
 

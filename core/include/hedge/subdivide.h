@@ -28,7 +28,7 @@ struct SubdivideOptions {
   std::size_t max_faces = 200'000'000;  //!< refuse (before starting) results larger than this
   unsigned threads = 0;                 //!< for the stencils and the connectivity; 0: thread_count()
   //! Degrees, 0 to 180: an interior edge whose two faces' normals differ by more is a crease
-  //! (kept sharp, see subdivide()). 180: none. Refused by sqrt3 below 180.
+  //! (kept sharp, see subdivide()). 180: none.
   double crease_angle = 180;
 };
 
@@ -39,7 +39,8 @@ struct SubdivideReport {
 };
 
 //! Face count after `options.iterations` steps of `options.scheme`, without refining.
-//! Precondition for loop and sqrt3: a triangle mesh.
+//! Precondition for loop and sqrt3: a triangle mesh. (sqrt3 with a crease angle measures the
+//! creases, which its trisecting steps cut in three.)
 std::size_t subdivided_face_count(const Mesh& mesh, const SubdivideOptions& options);
 
 //! Refines the mesh `options.iterations` times.
@@ -62,8 +63,12 @@ std::size_t subdivided_face_count(const Mesh& mesh, const SubdivideOptions& opti
 //! takes the curve rule (1/8, 6/8, 1/8) over the two far ends; a corner (three or more, e.g.
 //! a boundary vertex with an interior crease) stays where it is; a dart (one crease) takes
 //! the smooth rule. Copies of a vertex split by build() are classified each on its own.
-//! sqrt3 refuses crease_angle < 180 (Error): its flips and boundary trisection would need
-//! their own connectivity for creases. midpoint is linear, so creases change nothing there.
+//! sqrt3 treats a crease as a boundary seen from both sides (Kobbelt 2000's boundary rule):
+//! a crease is never flipped, it is cut in three on the even steps with the ternary stencils
+//! above, a vertex on two sharp edges (creases or boundary edges) stays through odd steps and
+//! takes (4, 19, 4)/27 along them on even ones; corners stay, darts are smooth, and where a
+//! crease ends (at a corner or a dart) its new points are the linear thirds. midpoint is
+//! linear, so creases change nothing there.
 //!
 //! Attributes: vertex properties are blended with the same stencils as positions (integer
 //! channels take the value of the heaviest source); corner properties are blended
@@ -79,7 +84,7 @@ std::size_t subdivided_face_count(const Mesh& mesh, const SubdivideOptions& opti
 //! those, in face order; sqrt3 puts the point of face f at V + f.
 //!
 //! Throws Error, leaving the mesh untouched, for polygons under loop/sqrt3, results above
-//! options.max_faces, crease_angle outside 0 to 180 or below 180 with sqrt3; Cancelled
+//! options.max_faces, crease_angle outside 0 to 180; Cancelled
 //! through progress likewise.
 SubdivideReport subdivide(Mesh& mesh, const SubdivideOptions& options, Progress& progress = Progress::none());
 

@@ -11,8 +11,8 @@
 #include <limits>
 #include <numbers>
 #include <thread>
-#include <typeinfo>
 #include <tuple>
+#include <typeinfo>
 #include <vector>
 
 #include "hedge/error.h"
@@ -351,6 +351,23 @@ std::vector<bool> detect_creases(const Mesh& m, double degrees) {
   return crease;
 }
 
+//! The sharp edges at v: its boundary edges and creases (`crease` per edge of m, not empty).
+//! How many, and the first two of them as half-edges leaving v.
+struct SharpEdges {
+  int count = 0;
+  Halfedge out[2];
+};
+
+SharpEdges sharp_edges(const Mesh& m, const std::vector<bool>& crease, Vertex v) {
+  SharpEdges sharp;
+  for (Halfedge h : m.outgoing(v))
+    if (m.is_boundary(Mesh::edge(h)) || crease[Mesh::edge(h).idx()]) {
+      if (sharp.count < 2) sharp.out[sharp.count] = h;
+      ++sharp.count;
+    }
+  return sharp;
+}
+
 //! After a split step: the two halves of a crease stay creases; interior edges are new and smooth.
 std::vector<bool> split_creases(const std::vector<bool>& crease, std::size_t edges_after) {
   std::vector<bool> next(edges_after, false);
@@ -528,21 +545,15 @@ Mesh split_step(const Mesh& m, SubdivisionScheme scheme, const std::vector<bool>
       // Hoppe et al. 1994 / DeRose et al. 1998, boundary edges counting as creases: a corner
       // (3 or more) stays, two interior creases give the curve rule along them, a dart (one)
       // falls through to the smooth rule, a plain boundary vertex to the boundary rule.
-      Index ends[2] = {kInvalidIndex, kInvalidIndex};
-      int sharp = 0;
-      for (Halfedge h : m.outgoing(v))
-        if (m.is_boundary(Mesh::edge(h)) || crease[Mesh::edge(h).idx()]) {
-          if (sharp < 2) ends[sharp] = m.to_vertex(h).idx();
-          ++sharp;
-        }
-      if (sharp >= 3) {
+      const SharpEdges sharp = sharp_edges(m, crease, v);
+      if (sharp.count >= 3) {
         s.add(v.idx(), 1.0f);
         return;
       }
-      if (sharp == 2 && !m.is_boundary(out_h)) {
+      if (sharp.count == 2 && !m.is_boundary(out_h)) {
         s.add(v.idx(), 0.75f);
-        s.add(ends[0], 0.125f);
-        s.add(ends[1], 0.125f);
+        s.add(m.to_vertex(sharp.out[0]).idx(), 0.125f);
+        s.add(m.to_vertex(sharp.out[1]).idx(), 0.125f);
         return;
       }
     }
@@ -614,15 +625,26 @@ Mesh split_step(const Mesh& m, SubdivisionScheme scheme, const std::vector<bool>
 // Kobbelt's boundary rule: every second step (`trisect`) cuts each boundary edge A -> B in
 // three at Q1, Q2, and the boundary triangle's slot (A, B, P_f) becomes (A, Q1, P_f),
 // (Q1, Q2, P_f), (Q2, B, P_f); positions follow the univariate ternary scheme, so two steps
-// refine the boundary curve 1 -> 3 as the interior is refined 1 -> 9. Boundary edge k
-// (numbered in edge order) adds vertices V + F + 2k (Q1) and + 1 (Q2), edges
-// E + 3F + 4k + {0: Q1-Q2, 1: Q2-B, 2: Q1-P_f, 3: Q2-P_f} (side 0 from the first named
-// vertex) and faces 3F + 2k + {0, 1}; the old edge keeps A-Q1.
-Mesh sqrt3_step(const Mesh& m, bool trisect, unsigned threads, Progress& progress, double from, double to) {
+// refine the boundary curve 1 -> 3 as the interior is refined 1 -> 9. A crease (`crease`, per
+// edge of m, empty for none) is a boundary seen from both sides: it is never flipped, and on
+// the same steps it is cut in three, each of its two triangles splitting like a boundary one.
+//
+// What a trisecting step adds: boundary edge k (in edge order) vertices V + F + 2k (Q1) and
+// + 1 (Q2), edges E + 3F + 4k + {0: Q1-Q2, 1: Q2-B, 2: Q1-P_f, 3: Q2-P_f} (side 0 from the
+// first named vertex) and faces 3F + 2k + {0, 1}; the old edge keeps A-Q1. Then crease c (in
+// edge order), A -> B its side-0 half-edge: vertices V + F + 2B + 2c + {0: Q1, 1: Q2}, edges
+// E + 3F + 4B + 6c + {0: Q1-Q2, 1: Q2-B} and, for its side s, + 2 + 2s (the spoke from the Q
+// nearer that side's origin to its face point) and + 3 + 2s (from the other Q), and faces
+// 3F + 2B + 4c + 2s + {0, 1}. On return `crease` is per edge of the result.
+Mesh sqrt3_step(const Mesh& m, bool trisect, std::vector<bool>& crease, unsigned threads, Progress& progress,
+                double from, double to) {
   const Index V = Index(m.vertices_size()), E = Index(m.edges_size()), F = Index(m.faces_size());
   const Index H = 2 * E;
-  std::vector<Index> boundary_number;  // edge -> k for boundary edges that are cut
+  const bool creases = !crease.empty();
+  std::vector<Index> boundary_number;    // edge -> k for boundary edges that are cut
   std::vector<Halfedge> boundary_inner;  // k -> the edge's half-edge inside its face
+  std::vector<Index> crease_number;      // edge -> c for creases (all are cut)
+  std::vector<Edge> cut_creases;         // c -> the edge
   if (trisect) {
     // Seams of split non-manifold edges stay as they are: the input's surface goes on there,
     // and their two sides must stay alike to weld back.
@@ -634,15 +656,36 @@ Mesh sqrt3_step(const Mesh& m, bool trisect, unsigned threads, Progress& progres
           boundary_number[e] = Index(boundary_inner.size());
           boundary_inner.push_back(Mesh::halfedge(Edge(e), 1 - side));
         }
+    if (creases) {
+      crease_number.assign(E, kInvalidIndex);
+      for (Index e = 0; e < E; ++e)
+        if (crease[e]) {
+          crease_number[e] = Index(cut_creases.size());
+          cut_creases.push_back(Edge(e));
+        }
+    }
   }
-  const std::size_t B = boundary_inner.size();
-  check_index_range(std::size_t(V) + F + 2 * B, std::size_t(E) + 3 * std::size_t(F) + 4 * B,
-                    3 * std::size_t(F) + 2 * B);
-  const Index V2 = Index(V + F + 2 * B), E2 = Index(E + 3 * F + 4 * B), F2 = Index(3 * F + 2 * B);
-  auto extra_halfedge = [&](Index k, Index which, unsigned side) { return Halfedge(2 * (E + 3 * F + 4 * k + which) + side); };
-  // The boundary half-edge leaving A along the cut edge (B -> Q2) when trisecting.
+  const std::size_t B = boundary_inner.size(), C = cut_creases.size();
+  check_index_range(std::size_t(V) + F + 2 * B + 2 * C, std::size_t(E) + 3 * std::size_t(F) + 4 * B + 6 * C,
+                    3 * std::size_t(F) + 2 * B + 4 * C);
+  const Index V2 = Index(V + F + 2 * B + 2 * C), E2 = Index(E + 3 * F + 4 * B + 6 * C);
+  const Index F2 = Index(3 * F + 2 * B + 4 * C);
+  // Where the creases' additions start: vertices, edges, faces, corner slots.
+  const Index crease_vertex0 = Index(V + F + 2 * B), crease_edge0 = Index(E + 3 * F + 4 * B);
+  const Index crease_face0 = Index(3 * F + 2 * B), crease_slot0 = Index(H + F + 2 * B);
+  auto extra_halfedge = [&](Index k, Index which, unsigned side) {
+    return Halfedge(2 * (E + 3 * F + 4 * k + which) + side);
+  };
+  auto crease_halfedge = [&](Index c, Index which, unsigned side) {
+    return Halfedge(2 * (crease_edge0 + 6 * c + which) + side);
+  };
+  auto is_crease = [&](Edge e) { return creases && crease[e.idx()]; };
+  // Boundary half-edge g is cut on this step; boundary_out(g) is the half-edge that then
+  // leaves g's origin B along the boundary (B -> Q2), g itself otherwise.
   auto is_cut = [&](Halfedge g) { return trisect && boundary_number[Mesh::edge(g).idx()] != kInvalidIndex; };
-  auto boundary_out = [&](Halfedge g) { return is_cut(g) ? extra_halfedge(boundary_number[Mesh::edge(g).idx()], 1, 1) : g; };
+  auto boundary_out = [&](Halfedge g) {
+    return is_cut(g) ? extra_halfedge(boundary_number[Mesh::edge(g).idx()], 1, 1) : g;
+  };
 
   // Corner number of every inner half-edge in its triangle (halfedge(f) is corner 0).
   std::vector<std::uint8_t> corner(H, 0);
@@ -663,8 +706,54 @@ Mesh sqrt3_step(const Mesh& m, bool trisect, unsigned threads, Progress& progres
   // Spoke (f, i) joins face point P_f and corner c_i; side 0 runs P_f -> c_i. The old inner
   // half-edge h = h_i of f (pointing to c_i) keeps its index: when its edge is interior it
   // becomes P_f -> P_g (g the face across), and triangle 3f + i is (c_i, P_f, P_g); on the
-  // boundary it stays, and triangle 3f + i is (c_{i-1}, c_i, P_f).
+  // boundary or a crease it stays, and triangle 3f + i is (c_{i-1}, c_i, P_f).
   auto spoke = [&](Index f, Index i, unsigned side) { return Halfedge(2 * (E + 3 * f + i % 3) + side); };
+
+  // The cut of the side of an edge A -> B that lies in face f (h its half-edge there, corner
+  // i): `first`, `mid` and `last` run A -> near -> far -> B, x and y are the spokes near ->
+  // P_f and far -> P_f, and triangle 3f + i becomes (A, near, P_f), t1 (near, far, P_f) and
+  // t2 (far, B, P_f); the corner slots hold the corners at near and far.
+  struct CutSide {
+    Halfedge first, mid, last, x, y;
+    Vertex near, far;
+    Face t1, t2;
+    Index near_slot, far_slot;
+  };
+  auto cut_side = [&](Index f, Index i, Halfedge h, const CutSide& c) {
+    const Vertex pf(V + f);
+    const Halfedge to_a = spoke(f, i + 2, 0), a = spoke(f, i, 1);  // P_f -> A, B -> P_f
+    out.set_vertex(c.first, c.near);
+    out.set_vertex(c.mid, c.far);
+    out.set_vertex(c.last, m.to_vertex(h));
+    out.set_vertex(c.x, pf);
+    out.set_vertex(Mesh::opposite(c.x), c.near);
+    out.set_vertex(c.y, pf);
+    out.set_vertex(Mesh::opposite(c.y), c.far);
+    const Halfedge loops[3][3] = {
+        {c.first, c.x, to_a}, {c.mid, c.y, Mesh::opposite(c.x)}, {c.last, a, Mesh::opposite(c.y)}};
+    const Face faces[3] = {Face(3 * f + i), c.t1, c.t2};
+    for (int j = 0; j < 3; ++j) {
+      for (int l = 0; l < 3; ++l) {
+        out.set_next(loops[j][l], loops[j][(l + 1) % 3]);
+        out.set_face(loops[j][l], faces[j]);
+      }
+      out.set_halfedge(faces[j], loops[j][0]);
+      if (face_props) fmap[faces[j].idx()] = f;
+    }
+    if (corner_props) {
+      hmap[c.first.idx()] = c.near_slot;
+      hmap[c.x.idx()] = H + f;
+      hmap[to_a.idx()] = m.prev(h).idx();
+      hmap[c.mid.idx()] = c.far_slot;
+      hmap[c.y.idx()] = H + f;
+      hmap[Mesh::opposite(c.x).idx()] = c.near_slot;
+      hmap[c.last.idx()] = h.idx();
+      hmap[a.idx()] = H + f;
+      hmap[Mesh::opposite(c.y).idx()] = c.far_slot;
+    }
+    if (edge_props) emap[Mesh::edge(c.x).idx()] = emap[Mesh::edge(c.y).idx()] = emap[E + 3 * f + i] = E;
+  };
+
   parallel_for(F, threads, [&](std::size_t lo, std::size_t hi) {
     for (Index f = Index(lo); f < hi; ++f) {
       const Vertex pf(V + f);
@@ -674,61 +763,51 @@ Mesh sqrt3_step(const Mesh& m, bool trisect, unsigned threads, Progress& progres
         out.set_vertex(spoke(f, i, 0), m.to_vertex(h));
         out.set_vertex(spoke(f, i, 1), pf);
         const Halfedge g = Mesh::opposite(h);
+        const Edge e = Mesh::edge(h);
         const Halfedge a = spoke(f, i, 1);
-        Halfedge b, c;
-        if (m.is_boundary(g) && is_cut(g)) {
-          const Index k = boundary_number[Mesh::edge(h).idx()];
-          const Vertex q1(V + F + 2 * k), q2(V + F + 2 * k + 1), corner_b = m.to_vertex(h);
+        const bool boundary = m.is_boundary(g), sharp = boundary || is_crease(e);
+        if (boundary && is_cut(g)) {
+          const Index k = boundary_number[e.idx()];
+          const Vertex q1(V + F + 2 * k), q2(V + F + 2 * k + 1);
           const Halfedge s1 = extra_halfedge(k, 0, 0), s2 = extra_halfedge(k, 1, 0);
-          const Halfedge x = extra_halfedge(k, 2, 0), y = extra_halfedge(k, 3, 0);  // Q1 -> P_f, Q2 -> P_f
-          const Halfedge to_a = spoke(f, i + 2, 0);                                  // P_f -> A
-          out.set_vertex(h, q1);
-          out.set_vertex(x, pf);
-          out.set_vertex(Mesh::opposite(x), q1);
-          out.set_vertex(s1, q2);
-          out.set_vertex(Mesh::opposite(s1), q1);
-          out.set_vertex(y, pf);
-          out.set_vertex(Mesh::opposite(y), q2);
-          out.set_vertex(s2, corner_b);
-          out.set_vertex(Mesh::opposite(s2), q2);
-          const Face t1(3 * F + 2 * k), t2(3 * F + 2 * k + 1);
-          const Halfedge loops[3][3] = {{h, x, to_a}, {s1, y, Mesh::opposite(x)}, {s2, a, Mesh::opposite(y)}};
-          const Face faces[3] = {t, t1, t2};
-          for (int j = 0; j < 3; ++j) {
-            for (int l = 0; l < 3; ++l) {
-              out.set_next(loops[j][l], loops[j][(l + 1) % 3]);
-              out.set_face(loops[j][l], faces[j]);
-            }
-            out.set_halfedge(faces[j], loops[j][0]);
-            if (face_props) fmap[faces[j].idx()] = f;
-          }
+          const Index slot = H + F + 2 * k;
+          cut_side(f, i, h,
+                   {h, s1, s2, extra_halfedge(k, 2, 0), extra_halfedge(k, 3, 0), q1, q2, Face(3 * F + 2 * k),
+                    Face(3 * F + 2 * k + 1), slot, slot + 1});
           // Along the boundary: B -> Q2 -> Q1 -> A (g keeps Q1 -> A; the edge loop links g on).
+          out.set_vertex(Mesh::opposite(s1), q1);
+          out.set_vertex(Mesh::opposite(s2), q2);
           out.set_next(Mesh::opposite(s2), Mesh::opposite(s1));
           out.set_next(Mesh::opposite(s1), g);
           out.set_halfedge(q1, g);
           out.set_halfedge(q2, Mesh::opposite(s1));
-          if (corner_props) {
-            const Index q1_slot = H + F + 2 * k, q2_slot = q1_slot + 1;
-            hmap[h.idx()] = q1_slot;
-            hmap[x.idx()] = H + f;
-            hmap[to_a.idx()] = m.prev(h).idx();
-            hmap[s1.idx()] = q2_slot;
-            hmap[y.idx()] = H + f;
-            hmap[Mesh::opposite(x).idx()] = q1_slot;
-            hmap[s2.idx()] = h.idx();
-            hmap[a.idx()] = H + f;
-            hmap[Mesh::opposite(y).idx()] = q2_slot;
-            hmap[Mesh::opposite(s1).idx()] = g.idx();  // boundary: the old boundary's defaults
-            hmap[Mesh::opposite(s2).idx()] = g.idx();
-          }
-          if (edge_props) {
-            emap[E + 3 * F + 4 * k] = emap[E + 3 * F + 4 * k + 1] = Mesh::edge(h).idx();
-            emap[E + 3 * F + 4 * k + 2] = emap[E + 3 * F + 4 * k + 3] = E;
-            emap[E + 3 * f + i] = E;
+          if (corner_props) hmap[Mesh::opposite(s1).idx()] = hmap[Mesh::opposite(s2).idx()] = g.idx();  // defaults
+          if (edge_props) emap[Mesh::edge(s1).idx()] = emap[Mesh::edge(s2).idx()] = e.idx();
+          continue;
+        }
+        if (sharp && !boundary && trisect) {
+          // A crease: its side 0 runs A -> Q1 -> Q2 -> B, side 1 B -> Q2 -> Q1 -> A.
+          const Index c = crease_number[e.idx()];
+          const unsigned side = h == Mesh::halfedge(e, 0) ? 0 : 1;
+          const Vertex q1(crease_vertex0 + 2 * c), q2(crease_vertex0 + 2 * c + 1);
+          const Halfedge x = crease_halfedge(c, 2 + 2 * side, 0), y = crease_halfedge(c, 3 + 2 * side, 0);
+          const Face t1(crease_face0 + 4 * c + 2 * side), t2(crease_face0 + 4 * c + 2 * side + 1);
+          const Index slot = crease_slot0 + 4 * c + 2 * side;
+          if (side == 0)
+            cut_side(f, i, h,
+                     {h, crease_halfedge(c, 0, 0), crease_halfedge(c, 1, 0), x, y, q1, q2, t1, t2, slot, slot + 1});
+          else
+            cut_side(f, i, h,
+                     {crease_halfedge(c, 1, 1), crease_halfedge(c, 0, 1), h, x, y, q2, q1, t1, t2, slot, slot + 1});
+          if (side == 0) {  // the shared elements, written once
+            out.set_halfedge(q1, x);
+            out.set_halfedge(q2, y);
+            if (edge_props) emap[crease_edge0 + 6 * c] = emap[crease_edge0 + 6 * c + 1] = e.idx();
           }
           continue;
         }
-        if (m.is_boundary(g)) {
+        Halfedge b, c;
+        if (sharp) {
           out.set_vertex(h, m.to_vertex(h));
           b = spoke(f, i + 2, 0);  // P_f -> c_{i-1}
           c = h;
@@ -789,7 +868,7 @@ Mesh sqrt3_step(const Mesh& m, bool trisect, unsigned threads, Progress& progres
 
   VertexRule rule;
   rule.V = V;
-  rule.added = Index(F + 2 * B);
+  rule.added = Index(F + 2 * B + 2 * C);
   rule.phases = {{0, rule.added}};
   auto added = [&](Index n, Stencil& s) {
     if (n < F) {
@@ -797,16 +876,50 @@ Mesh sqrt3_step(const Mesh& m, bool trisect, unsigned threads, Progress& progres
       return;
     }
     // The ternary rule: the point a third of the way from A to B is (10 B + 16 A + A') / 27,
-    // A' being A's other neighbour along the boundary.
-    const Halfedge h = boundary_inner[(n - F) / 2], g = Mesh::opposite(h);
-    const bool near_a = (n - F) % 2 == 0;
+    // A' being A's other neighbour along the boundary or crease.
+    const bool on_boundary = n < F + 2 * B;
+    const Index j = on_boundary ? n - F : n - F - Index(2 * B);
+    const Halfedge h = on_boundary ? boundary_inner[j / 2] : Mesh::halfedge(cut_creases[j / 2], 0);
+    const bool near_a = j % 2 == 0;
     const Vertex near = near_a ? m.from_vertex(h) : m.to_vertex(h), far = near_a ? m.to_vertex(h) : m.from_vertex(h);
-    const Vertex beyond = near_a ? m.to_vertex(m.next(g)) : m.from_vertex(m.prev(g));
+    Vertex beyond;
+    if (!creases) {
+      const Halfedge g = Mesh::opposite(h);
+      beyond = near_a ? m.to_vertex(m.next(g)) : m.from_vertex(m.prev(g));
+    } else {
+      const SharpEdges sharp = sharp_edges(m, crease, near);
+      if (sharp.count != 2) {
+        // A corner or a dart ends the curve there: the linear rule, as for a reflected A'.
+        s.add(near.idx(), 2.0f / 3);
+        s.add(far.idx(), 1.0f / 3);
+        return;
+      }
+      beyond = m.to_vertex(sharp.out[Mesh::edge(sharp.out[0]) == Mesh::edge(h) ? 1 : 0]);
+    }
     s.add(beyond.idx(), 1.0f / 27);
     s.add(near.idx(), 16.0f / 27);
     s.add(far.idx(), 10.0f / 27);
   };
   auto even = [&](Vertex v, Stencil& s) {
+    if (creases && m.halfedge(v).is_valid()) {
+      // As for Loop: a corner (three or more sharp edges) stays, a vertex on two follows the
+      // curve rule along them (here the boundary's), a dart (one) the smooth rule.
+      const SharpEdges sharp = sharp_edges(m, crease, v);
+      auto cut = [&](Halfedge h) {
+        const Edge e = Mesh::edge(h);
+        return trisect && (is_crease(e) || boundary_number[e.idx()] != kInvalidIndex);
+      };
+      if (sharp.count >= 3 || (sharp.count == 2 && (!cut(sharp.out[0]) || !cut(sharp.out[1])))) {
+        s.add(v.idx(), 1.0f);
+        return;
+      }
+      if (sharp.count == 2) {
+        s.add(m.to_vertex(sharp.out[0]).idx(), 4.0f / 27);
+        s.add(v.idx(), 19.0f / 27);
+        s.add(m.to_vertex(sharp.out[1]).idx(), 4.0f / 27);
+        return;
+      }
+    }
     if (m.is_boundary(v)) {
       const Halfedge out_h = m.halfedge(v);  // boundary: v -> next along the boundary
       // The boundary curve waits for the next step; isolated vertices and seams stay.
@@ -827,7 +940,7 @@ Mesh sqrt3_step(const Mesh& m, bool trisect, unsigned threads, Progress& progres
   refine_vertices(m, out, rule, threads, added, even);
   progress.update(from + 0.8 * (to - from), "subdividing: attributes");
 
-  refine_corners(m, out, F + 2 * B, hmap, threads, [&](const std::vector<Target>& all, unsigned t) {
+  refine_corners(m, out, F + 2 * B + 4 * C, hmap, threads, [&](const std::vector<Target>& all, unsigned t) {
     parallel_for(F, t, [&](std::size_t lo, std::size_t hi) {
       const float third[3] = {1.0f / 3, 1.0f / 3, 1.0f / 3};
       for (Index f = Index(lo); f < hi; ++f) {
@@ -837,16 +950,21 @@ Mesh sqrt3_step(const Mesh& m, bool trisect, unsigned threads, Progress& progres
       }
     });
     // Corners at Q1 and Q2 lie on the edge A -> B of their face: a third and two thirds along.
-    parallel_for(B, t, [&](std::size_t lo, std::size_t hi) {
-      const float near_a[2] = {2.0f / 3, 1.0f / 3}, near_b[2] = {1.0f / 3, 2.0f / 3};
-      for (std::size_t k = lo; k < hi; ++k) {
-        const Halfedge h = boundary_inner[k];
-        const Index sources[2] = {m.prev(h).idx(), h.idx()};  // the corners at A and B
-        for (const Target& x : all) {
-          blend(x, H + F + 2 * k, sources, near_a);
-          blend(x, H + F + 2 * k + 1, sources, near_b);
-        }
+    const float near_a[2] = {2.0f / 3, 1.0f / 3}, near_b[2] = {1.0f / 3, 2.0f / 3};
+    auto blend_cut = [&](Halfedge h, std::size_t slot) {
+      const Index sources[2] = {m.prev(h).idx(), h.idx()};  // the corners at A and B
+      for (const Target& x : all) {
+        blend(x, slot, sources, near_a);
+        blend(x, slot + 1, sources, near_b);
       }
+    };
+    parallel_for(B, t, [&](std::size_t lo, std::size_t hi) {
+      for (std::size_t k = lo; k < hi; ++k) blend_cut(boundary_inner[k], H + F + 2 * k);
+    });
+    parallel_for(C, t, [&](std::size_t lo, std::size_t hi) {
+      for (std::size_t c = lo; c < hi; ++c)
+        for (unsigned side = 0; side < 2; ++side)
+          blend_cut(Mesh::halfedge(cut_creases[c], side), crease_slot0 + 4 * c + 2 * side);
     });
   });
   if (edge_props)
@@ -857,6 +975,14 @@ Mesh sqrt3_step(const Mesh& m, bool trisect, unsigned threads, Progress& progres
     copy_parents(m.face_properties(), out.face_properties(), F, fmap, F2);
   else
     out.face_properties().resize(F2);
+  if (creases) {
+    // The old edges keep their flags (interior ones were flipped only if smooth); a cut
+    // crease's two new pieces are creases, the spokes are not.
+    std::vector<bool> next(E2, false);
+    for (Index e = 0; e < E; ++e) next[e] = crease[e];
+    for (std::size_t c = 0; c < C; ++c) next[crease_edge0 + 6 * c] = next[crease_edge0 + 6 * c + 1] = true;
+    crease = std::move(next);
+  }
   return out;
 }
 
@@ -900,7 +1026,9 @@ void weld_split_edge_points(const Mesh& before, Mesh& after) {
 
 //! Faces by kind, in one pass: what the refusals and the size forecast need.
 struct FaceCensus {
-  std::size_t faces = 0, triangles = 0, corners = 0, boundary_edges = 0;
+  std::size_t faces = 0, triangles = 0, corners = 0;
+  //! What a trisecting sqrt3 step cuts (count_sqrt3_cuts): boundary edges but seams, creases.
+  std::size_t boundary_edges = 0, crease_edges = 0;
 };
 
 FaceCensus face_census(const Mesh& mesh) {
@@ -911,8 +1039,18 @@ FaceCensus face_census(const Mesh& mesh) {
     c.triangles += n == 3;
     c.corners += n;
   }
-  for (Edge e : mesh.edges()) c.boundary_edges += mesh.is_boundary(e) ? 1 : 0;
   return c;
+}
+
+//! Fills in what sqrt3 cuts on its even steps (sqrt3_step): boundary edges other than the seams
+//! of split non-manifold edges, and the `crease_edges` creases. Others need no such count.
+void count_sqrt3_cuts(const Mesh& mesh, const SubdivideOptions& options, std::size_t crease_edges, FaceCensus& c) {
+  if (options.scheme != SubdivisionScheme::sqrt3 || options.iterations < 2) return;
+  c.crease_edges = crease_edges;
+  for (Edge e : mesh.edges()) c.boundary_edges += mesh.is_boundary(e) ? 1 : 0;
+  if (c.boundary_edges == 0) return;
+  const std::vector<bool> seam = split_seam_edges(mesh);
+  c.boundary_edges -= std::size_t(std::count(seam.begin(), seam.end(), true));
 }
 
 //! Corner normals were blended inside each face (hard edges stay hard): back to unit length.
@@ -945,14 +1083,16 @@ std::size_t forecast_faces(const FaceCensus& c, const SubdivideOptions& options)
       first = 4.0 * double(c.triangles) + double(c.corners - 3 * c.triangles);
       break;
   }
-  if (options.scheme == SubdivisionScheme::sqrt3 && c.boundary_edges) {
-    // Every second step cuts each boundary edge in three, adding two triangles for each.
-    double faces = double(c.faces), boundary = double(c.boundary_edges);
+  if (options.scheme == SubdivisionScheme::sqrt3 && (c.boundary_edges || c.crease_edges)) {
+    // Every second step cuts each boundary edge in three, adding two triangles for each, and
+    // each crease, adding two on either side.
+    double faces = double(c.faces), boundary = double(c.boundary_edges), creases = double(c.crease_edges);
     for (int it = 0; it < options.iterations && faces < 1e18; ++it) {
       faces *= 3;
       if (it % 2 == 1) {
-        faces += 2 * boundary;
+        faces += 2 * boundary + 4 * creases;
         boundary *= 3;
+        creases *= 3;
       }
     }
     return faces >= 1e18 ? std::size_t(1e18) : std::size_t(faces);
@@ -965,10 +1105,12 @@ std::size_t forecast_faces(const FaceCensus& c, const SubdivideOptions& options)
 //! Refuses, before starting, subdivisions whose vertices, half-edges or faces would not fit
 //! the 32-bit indices (whatever max_faces allows): the counts of every step, in doubles so
 //! that nothing wraps. Each step of loop, midpoint and catmull_clark splits every edge and
-//! adds an edge per corner inside each face; sqrt3 keeps the edges and adds 3 per triangle.
+//! adds an edge per corner inside each face; sqrt3 keeps the edges and adds 3 per triangle,
+//! and every second step cuts boundary edges and creases in three (sqrt3_step).
 void check_index_limits(const Mesh& mesh, const FaceCensus& census, const SubdivideOptions& options, const char* name) {
   double v = double(mesh.n_vertices()), e = double(mesh.n_edges()), f = double(census.faces);
   double t = double(census.triangles), c = double(census.corners);
+  double boundary = double(census.boundary_edges), creases = double(census.crease_edges);
   for (int it = 1; it <= options.iterations; ++it) {
     switch (options.scheme) {
       case SubdivisionScheme::loop:
@@ -988,6 +1130,13 @@ void check_index_limits(const Mesh& mesh, const FaceCensus& census, const Subdiv
         v += f;
         e += 3 * f;
         f *= 3;
+        if (it % 2 == 0) {
+          v += 2 * (boundary + creases);
+          e += 4 * boundary + 6 * creases;
+          f += 2 * boundary + 4 * creases;
+          boundary *= 3;
+          creases *= 3;
+        }
         t = f;
         c = 3 * f;
         break;
@@ -1036,7 +1185,14 @@ const char* subdivision_scheme_name(SubdivisionScheme scheme) {
 }
 
 std::size_t subdivided_face_count(const Mesh& mesh, const SubdivideOptions& options) {
-  return forecast_faces(face_census(mesh), options);
+  FaceCensus census = face_census(mesh);
+  std::size_t crease_edges = 0;
+  if (options.scheme == SubdivisionScheme::sqrt3 && options.crease_angle < 180) {
+    const std::vector<bool> crease = detect_creases(mesh, options.crease_angle);
+    crease_edges = std::size_t(std::count(crease.begin(), crease.end(), true));
+  }
+  count_sqrt3_cuts(mesh, options, crease_edges, census);
+  return forecast_faces(census, options);
 }
 
 SubdivideReport subdivide(Mesh& mesh, const SubdivideOptions& options, Progress& progress) {
@@ -1044,24 +1200,14 @@ SubdivideReport subdivide(Mesh& mesh, const SubdivideOptions& options, Progress&
   if (options.iterations < 1) throw Error("subdivide: iterations must be 1 or more");
   if (!(options.crease_angle >= 0 && options.crease_angle <= 180))
     throw Error("subdivide: crease_angle must be from 0 to 180 degrees");
-  // √3 flips every interior edge and trisects only real boundaries: creases would need
-  // connectivity of their own there.
-  if (options.scheme == SubdivisionScheme::sqrt3 && options.crease_angle < 180)
-    throw Error("subdivide: crease_angle is not supported by the sqrt3 scheme yet; use loop or catmull_clark");
   const bool triangles_only = options.scheme == SubdivisionScheme::loop || options.scheme == SubdivisionScheme::sqrt3;
-  const FaceCensus census = face_census(mesh);
+  const FaceCensus faces = face_census(mesh);
   if (triangles_only) {
-    if (std::size_t polygons = census.faces - census.triangles)
+    if (std::size_t polygons = faces.faces - faces.triangles)
       throw Error(std::string("subdivide: the ") + name + " scheme works on triangle meshes, and " +
                   std::to_string(polygons) + (polygons == 1 ? " face has" : " faces have") +
                   " more than 3 corners; triangulate first, or use catmull_clark or midpoint");
   }
-  check_index_limits(mesh, census, options, name);
-  const std::size_t predicted = forecast_faces(census, options);
-  if (predicted > options.max_faces)
-    throw Error("subdivide: " + std::to_string(options.iterations) + " iterations of " + name + " would make " +
-                std::to_string(predicted) + " faces, more than the limit of " + std::to_string(options.max_faces) +
-                "; use fewer iterations");
 
   // The steps read `current` and write a fresh mesh; the input is replaced only at the end,
   // so an error or a cancellation leaves it as it was.
@@ -1072,7 +1218,7 @@ SubdivideReport subdivide(Mesh& mesh, const SubdivideOptions& options, Progress&
     compacted.garbage_collect();
     current = &compacted;
   }
-  // Creases are found once, on the input; later steps carry them to the halves of their edges.
+  // Creases are found once, on the input; later steps carry them to the pieces of their edges.
   // (midpoint's rules are linear before they look at creases: found only for the report.)
   std::vector<bool> crease;
   std::size_t crease_edges = 0;
@@ -1081,15 +1227,26 @@ SubdivideReport subdivide(Mesh& mesh, const SubdivideOptions& options, Progress&
     crease_edges = std::size_t(std::count(crease.begin(), crease.end(), true));
     if (crease_edges == 0) crease.clear();
   }
+  FaceCensus census = faces;
+  count_sqrt3_cuts(*current, options, crease_edges, census);
+  check_index_limits(*current, census, options, name);
+  const std::size_t predicted = forecast_faces(census, options);
+  if (predicted > options.max_faces)
+    throw Error("subdivide: " + std::to_string(options.iterations) + " iterations of " + name + " would make " +
+                std::to_string(predicted) + " faces, more than the limit of " + std::to_string(options.max_faces) +
+                "; use fewer iterations");
   Mesh result;
   for (int it = 0; it < options.iterations; ++it) {
     const double from = double(it) / options.iterations, to = double(it + 1) / options.iterations;
     progress.update(from, "subdividing: step " + std::to_string(it + 1) + " of " + std::to_string(options.iterations));
-    Mesh next = options.scheme == SubdivisionScheme::sqrt3
-                    ? sqrt3_step(*current, it % 2 == 1, options.threads, progress, from, to)
-                    : split_step(*current, options.scheme, crease, options.threads, progress, from, to);
-    if (options.scheme != SubdivisionScheme::sqrt3) weld_split_edge_points(*current, next);
-    if (!crease.empty()) crease = split_creases(crease, next.edges_size());
+    Mesh next;
+    if (options.scheme == SubdivisionScheme::sqrt3) {
+      next = sqrt3_step(*current, it % 2 == 1, crease, options.threads, progress, from, to);
+    } else {
+      next = split_step(*current, options.scheme, crease, options.threads, progress, from, to);
+      weld_split_edge_points(*current, next);
+      if (!crease.empty()) crease = split_creases(crease, next.edges_size());
+    }
     result = std::move(next);
     current = &result;
   }
@@ -1122,7 +1279,8 @@ Operation subdivide_operation() {
       "in three on every second iteration of a run (use an even number of iterations on open meshes). "
       "Creases: with a crease angle below 180, edges where the surface bends more sharply stay sharp under loop "
       "and catmull_clark (Hoppe et al. 1994; DeRose et al. 1998): they are refined as curves and the corners "
-      "where three or more meet stay put; sqrt3 refuses them, midpoint has no smoothing to undo. "
+      "where three or more meet stay put; sqrt3 keeps them like boundaries (never flipped, cut in three on every "
+      "second iteration); midpoint has no smoothing to undo. "
       "Attributes: vertex attributes are blended with the scheme's own weights, corner attributes (UVs) linearly "
       "inside each old face so seams stay seams, face attributes (materials) are copied to the child faces; normals "
       "are recomputed for the new shape. "
@@ -1135,8 +1293,7 @@ Operation subdivide_operation() {
                          "refinement steps; each multiplies the face count by 4 (sqrt3: 3)"),
       ParamSpec::real("crease_angle", "Crease angle", 180, 0, 180,
                       "degrees: edges where the two faces' normals differ by more than this stay sharp (creases "
-                      "and corners, e.g. a cube's edges at 60); 180 smooths everything. loop and catmull_clark "
-                      "only: sqrt3 refuses values below 180"),
+                      "and corners, e.g. a cube's edges at 60); 180 smooths everything"),
   };
   op.run = [](Mesh& mesh, const ParamValues& values, Progress& progress) {
     SubdivideOptions options;
