@@ -1066,7 +1066,7 @@ TEST(SubdivideCreases, CreasesAreMeasuredOnceOnTheInput) {
     if (bunny.is_boundary(e)) continue;
     const Vec3d a = to_double(normal[bunny.face(Mesh::halfedge(e, 0)).idx()]);
     const Vec3d b = to_double(normal[bunny.face(Mesh::halfedge(e, 1)).idx()]);
-    if (std::atan2(norm(cross(a, b)), dot(a, b)) * 180 / std::numbers::pi > 30) creases.push_back(e);
+    if (angle_between(a, b) * 180 / std::numbers::pi > 30) creases.push_back(e);
   }
   Mesh once = bunny, twice = bunny;
   const SubdivideReport r = subdivide(once, creased(SubdivisionScheme::loop, 30));

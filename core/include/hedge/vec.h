@@ -65,16 +65,33 @@ constexpr Vec<T, 3> cross(const Vec<T, 3>& a, const Vec<T, 3>& b) {
   return {{a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]}};
 }
 template <class T, int N>
-inline T sqrnorm(const Vec<T, N>& a) { return dot(a, a); }
+inline T sqrnorm(const Vec<T, N>& a) {
+  return dot(a, a);
+}
 template <class T, int N>
-inline T norm(const Vec<T, N>& a) { return std::sqrt(dot(a, a)); }
+inline T norm(const Vec<T, N>& a) {
+  return std::sqrt(dot(a, a));
+}
 template <class T, int N>
-inline T distance(const Vec<T, N>& a, const Vec<T, N>& b) { return norm(a - b); }
+inline T distance(const Vec<T, N>& a, const Vec<T, N>& b) {
+  return norm(a - b);
+}
 //! a / |a|, or a unchanged when it has zero length.
 template <class T, int N>
 inline Vec<T, N> normalize(Vec<T, N> a) {
   T n = norm(a);
   return n > T(0) ? a / n : a;
+}
+//! The angle between u and v in radians, 0 to pi (0 when either is zero); atan2 rather than
+//! acos, which loses its precision near 0 and pi.
+template <class T>
+inline T angle_between(const Vec<T, 3>& u, const Vec<T, 3>& v) {
+  return std::atan2(norm(cross(u, v)), dot(u, v));
+}
+//! The angle of triangle (corner, a, b) at corner, in radians.
+template <class T>
+inline T angle_at(const Vec<T, 3>& corner, const Vec<T, 3>& a, const Vec<T, 3>& b) {
+  return angle_between(a - corner, b - corner);
 }
 inline Vec3d to_double(const Vec3f& p) { return static_cast<Vec3d>(p); }
 inline Vec3f to_float(const Vec3d& p) { return static_cast<Vec3f>(p); }

@@ -32,18 +32,11 @@ Quad quad_of(const Mesh& m, Edge e) {
   return q;
 }
 
-double angle_at(const Vec3d& apex, const Vec3d& a, const Vec3d& b) {
-  const Vec3d x = a - apex, y = b - apex;
-  return std::atan2(norm(cross(x, y)), dot(x, y));
-}
-
 Vec3d normal(const Vec3d& a, const Vec3d& b, const Vec3d& c) { return cross(b - a, c - a); }
 
 //! Angle between two normals in degrees; 0 when either is zero (a degenerate triangle bends
 //! nothing, and flipping it away is what Delaunay flips are for).
-double degrees_between(const Vec3d& n0, const Vec3d& n1) {
-  return std::atan2(norm(cross(n0, n1)), dot(n0, n1)) * 180.0 / std::numbers::pi;
-}
+double degrees_between(const Vec3d& n0, const Vec3d& n1) { return angle_between(n0, n1) * 180.0 / std::numbers::pi; }
 
 bool is_triangle(const Mesh& m, Halfedge h) { return m.next(m.next(m.next(h))) == h; }
 

@@ -77,11 +77,6 @@ Vec3d unit_normal(const Mesh& mesh, Face f) {
   return length > 0 ? n / length : Vec3d{};
 }
 
-double angle_at(const Vec3d& corner, const Vec3d& a, const Vec3d& b) {
-  Vec3d u = a - corner, v = b - corner;
-  return std::atan2(norm(cross(u, v)), dot(u, v));
-}
-
 double triangle_area(const Vec3d& a, const Vec3d& b, const Vec3d& c) { return 0.5 * norm(cross(b - a, c - a)); }
 
 // 1 - cos of the dihedral angle between two unit normals (0 = flat, 2 = folded back); no

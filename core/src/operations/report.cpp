@@ -20,12 +20,7 @@ double triangle_quality(const Vec3d& a, const Vec3d& b, const Vec3d& c) {
 }
 
 double triangle_min_angle(const Vec3d& a, const Vec3d& b, const Vec3d& c) {
-  auto angle = [](const Vec3d& p, const Vec3d& q, const Vec3d& r) {
-    Vec3d u = q - p, v = r - p;
-    double n = norm(cross(u, v));
-    return std::atan2(n, dot(u, v));
-  };
-  double m = std::min({angle(a, b, c), angle(b, c, a), angle(c, a, b)});
+  double m = std::min({angle_at(a, b, c), angle_at(b, c, a), angle_at(c, a, b)});
   return m * 180.0 / std::numbers::pi;
 }
 
@@ -80,9 +75,12 @@ MeshStatistics mesh_statistics(const Mesh& mesh) {
   s.quality_min = 1;
   for (Face f : mesh.faces()) {
     std::size_t n = mesh.valence(f);
-    if (n == 3) ++s.triangles;
-    else if (n == 4) ++s.quads;
-    else ++s.polygons;
+    if (n == 3)
+      ++s.triangles;
+    else if (n == 4)
+      ++s.quads;
+    else
+      ++s.polygons;
     Halfedge h0 = mesh.halfedge(f);
     Vec3d p0 = to_double(mesh.position(mesh.to_vertex(h0)));
     Vec3d normal{};

@@ -345,8 +345,7 @@ std::vector<bool> detect_creases(const Mesh& m, double degrees) {
     const Vec3d n0 = to_double(normal[m.face(Mesh::halfedge(e, 0)).idx()]);
     const Vec3d n1 = to_double(normal[m.face(Mesh::halfedge(e, 1)).idx()]);
     if (sqrnorm(n0) == 0 || sqrnorm(n1) == 0) continue;
-    // atan2 rather than acos: exact near 0 and 180 degrees.
-    crease[e.idx()] = std::atan2(norm(cross(n0, n1)), dot(n0, n1)) * 180.0 / std::numbers::pi > degrees;
+    crease[e.idx()] = angle_between(n0, n1) * 180.0 / std::numbers::pi > degrees;
   }
   return crease;
 }
