@@ -146,6 +146,7 @@ inline constexpr const char* kOpDecimate = "decimate";  // to 10 % of the input'
 inline constexpr const char* kOpRemesh = "remesh";      // isotropic, mean edge length, 3 iterations
 inline constexpr const char* kOpLoop = "loop";          // Loop subdivision, 1 step
 inline constexpr const char* kOpCatmull = "catmull";    // Catmull-Clark subdivision, 1 step
+inline constexpr const char* kOpSqrt3 = "sqrt3";        // Kobbelt's sqrt3 subdivision, 1 step
 inline constexpr const char* kOpSmooth = "smooth";      // uniform Laplace, Jacobi, 10 steps of 1/2
 inline constexpr double kDecimateRatio = 0.1;
 inline constexpr int kRemeshIterations = 3;

@@ -200,19 +200,18 @@ OpRun remesh_run(double target) {
                         [](const SMesh& mesh) { return to_soup(mesh); });
 }
 
-OpRun loop_run(double) {
-  return time_operation([] { return build_mesh(false); },
-                        [&](SMesh& mesh) {
-                          CGAL::Subdivision_method_3::Loop_subdivision(mesh, CGAL::parameters::number_of_iterations(1));
-                        },
-                        [](const SMesh& mesh) { return to_soup(mesh); });
-}
+//! One step of a Subdivision_method_3 scheme.
+enum class Scheme { loop, catmull_clark, sqrt3 };
 
-OpRun catmull_run(double) {
+template <Scheme scheme>
+OpRun subdivide_run(double) {
   return time_operation([] { return build_mesh(false); },
                         [&](SMesh& mesh) {
-                          CGAL::Subdivision_method_3::CatmullClark_subdivision(
-                              mesh, CGAL::parameters::number_of_iterations(1));
+                          namespace SM = CGAL::Subdivision_method_3;
+                          const auto one_step = CGAL::parameters::number_of_iterations(1);
+                          if constexpr (scheme == Scheme::loop) SM::Loop_subdivision(mesh, one_step);
+                          if constexpr (scheme == Scheme::catmull_clark) SM::CatmullClark_subdivision(mesh, one_step);
+                          if constexpr (scheme == Scheme::sqrt3) SM::Sqrt3_subdivision(mesh, one_step);
                         },
                         [](const SMesh& mesh) { return to_soup(mesh); });
 }
@@ -232,8 +231,9 @@ std::vector<Entry> cgal_benchmarks() {
 std::vector<OpEntry> cgal_operations() {
   return {{kOpDecimate, "SMS::edge_collapse, GarlandHeckbert_plane_policies (policy set-up included)", decimate_run},
           {kOpRemesh, "PMP::isotropic_remeshing(faces(mesh), L, mesh, number_of_iterations(3))", remesh_run},
-          {kOpLoop, "Subdivision_method_3::Loop_subdivision, 1 step", loop_run},
-          {kOpCatmull, "Subdivision_method_3::CatmullClark_subdivision, 1 step", catmull_run}};
+          {kOpLoop, "Subdivision_method_3::Loop_subdivision, 1 step", subdivide_run<Scheme::loop>},
+          {kOpCatmull, "Subdivision_method_3::CatmullClark_subdivision, 1 step", subdivide_run<Scheme::catmull_clark>},
+          {kOpSqrt3, "Subdivision_method_3::Sqrt3_subdivision, 1 step", subdivide_run<Scheme::sqrt3>}};
 }
 
 }  // namespace bench

@@ -141,17 +141,15 @@ void remesh_op(hedge::Mesh& mesh) {
   hedge::remesh(mesh, options);
 }
 
-void loop_op(hedge::Mesh& mesh) {
-  hedge::SubdivideOptions options;
-  options.scheme = hedge::SubdivisionScheme::loop;
+template <hedge::SubdivisionScheme scheme>
+void subdivide_op(hedge::Mesh& mesh) {
+  hedge::SubdivideOptions options;  // one step, no creases
+  options.scheme = scheme;
   hedge::subdivide(mesh, options);
 }
-
-void catmull_op(hedge::Mesh& mesh) {
-  hedge::SubdivideOptions options;
-  options.scheme = hedge::SubdivisionScheme::catmull_clark;
-  hedge::subdivide(mesh, options);
-}
+constexpr auto loop_op = subdivide_op<hedge::SubdivisionScheme::loop>;
+constexpr auto catmull_op = subdivide_op<hedge::SubdivisionScheme::catmull_clark>;
+constexpr auto sqrt3_op = subdivide_op<hedge::SubdivisionScheme::sqrt3>;
 
 void smooth_op(hedge::Mesh& mesh) {
   hedge::SmoothOptions options;  // uniform weights, 1/2 of the way, boundary fixed
@@ -175,6 +173,7 @@ std::vector<OpEntry> hedge_operations() {
           {kOpRemesh, alone, run_op<remesh_op, false>},     {kOpRemesh, io, run_op<remesh_op, true>},
           {kOpLoop, alone, run_op<loop_op, false>},         {kOpLoop, io, run_op<loop_op, true>},
           {kOpCatmull, alone, run_op<catmull_op, false>},   {kOpCatmull, io, run_op<catmull_op, true>},
+          {kOpSqrt3, alone, run_op<sqrt3_op, false>},       {kOpSqrt3, io, run_op<sqrt3_op, true>},
           {kOpSmooth, alone, run_op<smooth_op, false>},     {kOpSmooth, io, run_op<smooth_op, true>}};
 }
 

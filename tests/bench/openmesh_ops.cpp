@@ -7,6 +7,7 @@
 #include <OpenMesh/Tools/Decimater/ModQuadricT.hh>
 #include <OpenMesh/Tools/Smoother/JacobiLaplaceSmootherT.hh>
 #include <OpenMesh/Tools/Subdivider/Uniform/LoopT.hh>
+#include <OpenMesh/Tools/Subdivider/Uniform/Sqrt3T.hh>
 #include <cmath>
 #include <memory>
 #include <vector>
@@ -190,15 +191,16 @@ OpRun decimate_run(double) {
                         [](const OMesh& mesh) { return to_soup(mesh); });
 }
 
-//! Subdivider::Uniform::LoopT, one step.
-OpRun loop_run(double) {
+//! One step of a Subdivider::Uniform scheme (LoopT, Sqrt3T), with its default precision.
+template <template <class> class Subdivider>
+OpRun subdivide_run(double) {
   return time_operation([] { return build_mesh(false); },
                         [&](OMesh& mesh) {
                           {
-                            OpenMesh::Subdivider::Uniform::LoopT<OMesh> loop;
-                            loop.attach(mesh);
-                            loop(1);
-                            loop.detach();
+                            Subdivider<OMesh> subdivider;
+                            subdivider.attach(mesh);
+                            subdivider(1);
+                            subdivider.detach();
                           }
                         },
                         [](const OMesh& mesh) { return to_soup(mesh); });
@@ -245,7 +247,8 @@ std::vector<Entry> openmesh_benchmarks() {
 
 std::vector<OpEntry> openmesh_operations() {
   return {{kOpDecimate, "DecimaterT + ModQuadricT: initialize, decimate_to_faces, garbage_collection", decimate_run},
-          {kOpLoop, "Subdivider::Uniform::LoopT, 1 step", loop_run},
+          {kOpLoop, "Subdivider::Uniform::LoopT, 1 step", subdivide_run<OpenMesh::Subdivider::Uniform::LoopT>},
+          {kOpSqrt3, "Subdivider::Uniform::Sqrt3T, 1 step", subdivide_run<OpenMesh::Subdivider::Uniform::Sqrt3T>},
           {kOpSmooth, "JacobiLaplaceSmootherT: constructor, initialize, smooth(10)", smooth_run}};
 }
 

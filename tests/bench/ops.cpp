@@ -1,5 +1,5 @@
-// hedge_bench --ops: whole operations (decimate, remesh, Loop and Catmull-Clark subdivision,
-// Laplace smoothing) of hedge next to OpenMesh and CGAL in this process, and with --hosts
+// hedge_bench --ops: whole operations (decimate, remesh, Loop, Catmull-Clark and sqrt3
+// subdivision, Laplace smoothing) of hedge next to OpenMesh and CGAL in this process, and with --hosts
 // next to MeshLab's own filters (meshlabserver) and Blender's Decimate modifier (blender -b)
 // as separate processes. One table: times, ratios peer/hedge, result sizes, and for the
 // operations that keep the surface, the symmetric Hausdorff distance to the input.
@@ -334,11 +334,15 @@ std::string cell(double x, const char* format) {
   return buf;
 }
 
+//! The table's operations, in its order.
+constexpr const char* kTableOps[] = {kOpDecimate, kOpRemesh, kOpLoop, kOpCatmull, kOpSqrt3, kOpSmooth};
+
 const char* op_title(const std::string& op) {
   if (op == kOpDecimate) return "decimate to 10%";
   if (op == kOpRemesh) return "remesh, 3 iterations";
   if (op == kOpLoop) return "Loop subdivision x1";
   if (op == kOpCatmull) return "Catmull-Clark x1";
+  if (op == kOpSqrt3) return "sqrt3 subdivision x1";
   if (op == kOpSmooth) return "Laplace smooth x10";
   return op.c_str();
 }
@@ -407,7 +411,7 @@ int run_operation_table(int reps, bool hosts) {
   const std::vector<std::pair<std::string, std::vector<OpEntry>>> libraries = {
       {"hedge", hedge_operations()}, {"OpenMesh", openmesh_operations()}, {"CGAL", cgal_operations()}};
   std::fprintf(stderr, "operations on %s, %d run(s) each:\n", mesh_name.c_str(), reps);
-  for (const char* op : {kOpDecimate, kOpRemesh, kOpLoop, kOpCatmull, kOpSmooth}) {
+  for (const char* op : kTableOps) {
     for (const auto& [library, entries] : libraries) {
       bool first_hedge = true;
       for (const OpEntry& e : entries) {
@@ -435,7 +439,7 @@ int run_operation_table(int reps, bool hosts) {
     Row blender = run_blender(dir, ref);
     // Each host's rows next to the library rows of the same operation.
     std::vector<Row> merged;
-    for (const char* op : {kOpDecimate, kOpRemesh, kOpLoop, kOpCatmull, kOpSmooth}) {
+    for (const char* op : kTableOps) {
       for (const Row& r : rows)
         if (r.op == op) merged.push_back(r);
       for (const Row& r : meshlab)
