@@ -141,6 +141,25 @@ class PrimitivesTest(unittest.TestCase):
         bpy.ops.mesh.hedge_subdivide(scheme='loop', iterations=1)
         self.assertEqual(len(monkey.data.polygons), 4 * n)
 
+    def test_subdivide_creases_keep_the_cube(self):
+        # crease_angle reaches the operator: at 60 degrees the cube's 12 edges are creases, so
+        # loop and sqrt3 (Kobbelt's boundary rule on them) keep it a cube of side 2; at 180 it rounds off.
+        for scheme, iterations, faces in (('loop', 2, 12 * 16), ('sqrt3', 2, 12 * 9 + 4 * 12)):
+            for angle in (60.0, 180.0):
+                cube = add_primitive("cube")
+                bpy.ops.mesh.hedge_triangulate(method='min_area')
+                result = bpy.ops.mesh.hedge_subdivide(scheme=scheme, iterations=iterations, crease_angle=angle)
+                self.assertEqual(result, {'FINISHED'})
+                self.assertEqual(len(cube.data.polygons), faces if angle < 180 else 12 * (16 if scheme == 'loop' else 9))
+                p = mesh_arrays(cube.data)["co"].reshape(-1, 3)
+                on_side = np.isclose(np.abs(p), 1, atol=1e-5).any(axis=1)
+                if angle < 180:
+                    self.assertTrue(np.all(on_side), f"{scheme}: a vertex left the cube's surface")
+                    self.assertTrue(np.all(np.abs(p) <= 1 + 1e-5))
+                else:
+                    self.assertFalse(np.all(on_side), f"{scheme}: the uncreased cube did not round off")
+                bpy.data.objects.remove(cube)
+
     def test_triangulate_polygons(self):
         obj = add_primitive("cylinder", vertices=32)  # two 32-gons and quads
         bpy.ops.mesh.hedge_triangulate(method='min_area')

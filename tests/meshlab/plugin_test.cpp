@@ -318,6 +318,24 @@ TEST_F(PluginTest, PolygonsSurviveAChainOfFilters) {
   EXPECT_NE(doc.log_text().find("Hedge: Mesh Report: quads = " + std::to_string(4 * 3 * 3674)), std::string::npos);
 }
 
+// crease_angle reaches the core through MeshLab's dialog: two sqrt3 steps at 30 degrees keep the
+// bunny's creases, each cut in three by the second step with two new triangles on either side.
+TEST_F(PluginTest, Sqrt3CreasesFromTheDialog) {
+  Document doc(mesh_path("bunny.off"));
+  RichParameterList parameters = doc.defaults(action_of("subdivide"));
+  parameters.setValue("scheme", EnumValue(2));  // sqrt3
+  parameters.setValue("iterations", IntValue(2));
+  parameters.setValue("crease_angle", DynamicFloatValue(30));
+  ASSERT_TRUE(doc.apply("subdivide", parameters)) << doc.log_text();
+  const std::string log = doc.log_text();
+  const std::string key = "Hedge: Subdivide: crease_edges = ";
+  const std::size_t at = log.find(key);
+  ASSERT_NE(at, std::string::npos) << log;
+  const int creases = std::stoi(log.substr(at + key.size()));
+  EXPECT_GT(creases, 100);
+  EXPECT_EQ(doc.model->cm.fn, 9 * 3674 + 4 * creases);
+}
+
 TEST_F(PluginTest, NoMeshIsAnErrorNotACrash) {
   MeshDocument empty;
   GLLogStream log;
