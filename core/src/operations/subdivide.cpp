@@ -34,8 +34,10 @@ class Stencil {
   Stencil(const Stencil&) = delete;
   Stencil& operator=(const Stencil&) = delete;
   void clear() { size_ = 0; }
-  void add(Index i, float w) {
-    if (size_ == capacity_) grow();
+  // Inlined into the stencil loops (it runs once per weight); growing is rare and kept apart.
+  [[gnu::always_inline]] void add(Index i, float w) {
+    if (size_ == capacity_) [[unlikely]]
+      grow();
     index_[size_] = i;
     weight_[size_] = w;
     ++size_;
@@ -48,7 +50,7 @@ class Stencil {
   float weight(std::size_t i) const { return weight_[i]; }
 
  private:
-  void grow() {
+  [[gnu::noinline]] void grow() {
     capacity_ *= 2;
     std::vector<Index> index(capacity_);
     std::vector<float> weight(capacity_);
@@ -135,15 +137,22 @@ double loop_beta_formula(std::size_t n) {
   return (5.0 / 8.0 - c * c) / double(n);
 }
 
-//! Loop's beta(n) = (5/8 - (3/8 + cos(2 pi / n) / 4)^2) / n; common valences from a table.
-double loop_beta(std::size_t n) {
+//! Kobbelt's alpha(n) = (4 - 2 cos(2 pi / n)) / 9, the weight a √3 vertex gives its ring.
+double sqrt3_alpha_formula(std::size_t n) { return (4.0 - 2.0 * std::cos(2.0 * std::numbers::pi / double(n))) / 9.0; }
+
+//! Formula(n), common valences from a table made once (no cosine per vertex).
+template <double (*Formula)(std::size_t)>
+double tabulated(std::size_t n) {
   static const auto table = [] {
     std::array<double, 33> t{};
-    for (std::size_t k = 1; k < t.size(); ++k) t[k] = loop_beta_formula(k);
+    for (std::size_t k = 1; k < t.size(); ++k) t[k] = Formula(k);
     return t;
   }();
-  return n < table.size() ? table[n] : loop_beta_formula(n);
+  return n < table.size() ? table[n] : Formula(n);
 }
+
+//! Loop's beta(n) = (5/8 - (3/8 + cos(2 pi / n) / 4)^2) / n.
+double loop_beta(std::size_t n) { return tabulated<loop_beta_formula>(n); }
 
 //! New vertices of a step: old vertices keep their indices, added vertices follow at
 //! V, V+1, ... Stencils index old vertices (< V) by their old values and added vertices by
@@ -173,54 +182,54 @@ void refine_vertices(const Mesh& m, Mesh& out, const VertexRule& rule, unsigned 
     }
     return Point{{x, y, z}};
   };
-  for (const auto& phase : rule.phases)
-    parallel_for(phase.second - phase.first, threads, [&, b = phase.first](std::size_t lo, std::size_t hi) {
-      Stencil s;
-      for (std::size_t k = b + lo; k < b + hi; ++k) {
-        s.clear();
-        added(Index(k), s);
-        p[V + k] = position(s);
-      }
-    });
-  parallel_for(V, threads, [&](std::size_t lo, std::size_t hi) {
-    Stencil s;
-    for (std::size_t v = lo; v < hi; ++v) {
-      s.clear();
-      even(Vertex(Index(v)), s);
-      p[v] = position(s);
-    }
-  });
-
   // Properties: slots [0, V) old values, [V, V + N) the added vertices, [V + N, 2V + N) the old
   // vertices' new values; the final order is a gather.
   PropertyContainer props = m.vertex_properties();
+  std::vector<Target> all;
   if (props.count()) {
     props.resize(std::size_t(2) * V + N);
-    std::vector<Target> all = targets(props);
-    threads = threads_for(all, threads);
+    all = targets(props);
+  }
+  // Each stencil is made once and feeds the position and the properties, unless the
+  // properties must be written by one thread (then they take a pass of their own).
+  auto pass = [&](bool positions, bool properties, unsigned t) {
     for (const auto& phase : rule.phases)
-      parallel_for(phase.second - phase.first, threads, [&, b = phase.first](std::size_t lo, std::size_t hi) {
+      parallel_for(phase.second - phase.first, t, [&, b = phase.first](std::size_t lo, std::size_t hi) {
         Stencil s;
         for (std::size_t k = b + lo; k < b + hi; ++k) {
           s.clear();
           added(Index(k), s);
-          for (const Target& t : all)
-            if (!t.internal) blend(t, V + k, s.index(), s.weight());  // new vertices: no bookkeeping
+          if (positions) p[V + k] = position(s);
+          if (properties)
+            for (const Target& x : all)
+              if (!x.internal) blend(x, V + k, s.index(), s.weight());  // new vertices: no bookkeeping
         }
       });
-    parallel_for(V, threads, [&](std::size_t lo, std::size_t hi) {
+    parallel_for(V, t, [&](std::size_t lo, std::size_t hi) {
       Stencil s;
       for (std::size_t v = lo; v < hi; ++v) {
         s.clear();
         even(Vertex(Index(v)), s);
-        for (const Target& t : all) {
-          if (t.internal)
-            t.array->copy_element(v, V + N + v);
-          else
-            blend(t, V + N + v, s.index(), s.weight());
-        }
+        if (positions) p[v] = position(s);
+        if (properties)
+          for (const Target& x : all) {
+            if (x.internal)
+              x.array->copy_element(v, V + N + v);
+            else
+              blend(x, V + N + v, s.index(), s.weight());
+          }
       }
     });
+  };
+  const unsigned property_threads = threads_for(all, threads);
+  if (all.empty() || property_threads == threads) {
+    pass(true, !all.empty(), threads);
+  } else {
+    pass(true, false, threads);
+    pass(false, true, property_threads);
+  }
+
+  if (!all.empty()) {
     std::vector<Index> order(std::size_t(V) + N);
     for (Index v = 0; v < V; ++v) order[v] = V + N + v;
     for (Index k = 0; k < N; ++k) order[V + k] = V + k;
@@ -931,10 +940,13 @@ Mesh sqrt3_step(const Mesh& m, bool trisect, std::vector<bool>& crease, unsigned
       s.add(m.to_vertex(out_h).idx(), 4.0f / 27);
       return;
     }
-    const std::size_t n = m.valence(v);
-    const double alpha = (4.0 - 2.0 * std::cos(2.0 * std::numbers::pi / double(n))) / 9.0;
-    s.add(v.idx(), float(1.0 - alpha));
-    for (Vertex w : m.vertices(v)) s.add(w.idx(), float(alpha / double(n)));
+    // One walk around v gathers the ring; the weights depend on its size, set afterwards.
+    s.add(v.idx(), 0.0f);
+    for (Vertex w : m.vertices(v)) s.add(w.idx(), 0.0f);
+    const std::size_t n = s.size() - 1;
+    const double alpha = tabulated<sqrt3_alpha_formula>(n);
+    s.weight(0) = float(1.0 - alpha);
+    for (std::size_t i = 1; i <= n; ++i) s.weight(i) = float(alpha / double(n));
   };
   refine_vertices(m, out, rule, threads, added, even);
   progress.update(from + 0.8 * (to - from), "subdividing: attributes");
