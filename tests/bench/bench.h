@@ -184,7 +184,8 @@ std::vector<OpEntry> cgal_operations();
 
 //! Runs the operation table (and, with `hosts`, MeshLab and Blender as separate processes);
 //! returns the process exit code.
-int run_operation_table(int reps, bool hosts);
+//! `only`: the operation ids to run (kOpLoop, ...); empty for all.
+int run_operation_table(int reps, bool hosts, const std::vector<std::string>& only = {});
 //! --scale (scale.cpp): the pipeline on 10M+ triangles and cost per triangle by size;
 //! growth_only skips the pipeline.
 int run_scale(const std::string& dragon_path, bool growth_only);

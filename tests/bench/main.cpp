@@ -256,6 +256,8 @@ void usage() {
       "                 against OpenMesh and CGAL in this process (ops.cpp)\n"
       "  --hosts        with --ops: also MeshLab (meshlabserver) and Blender (blender -b); slow\n"
       "  --op-reps N    runs per library and operation in the --ops table (default 1)\n"
+      "  --op NAME      with --ops: only this operation in the in-process table (decimate, remesh,\n"
+      "                 loop, catmull, sqrt3, smooth); repeatable\n"
       "  --scale        instead: the pipeline on the mesh Loop-subdivided to 10M+ triangles, and\n"
       "                 build/decimate cost per triangle from 100k to 14M (--scale-growth: only that)\n");
   benchmark::PrintDefaultHelp();
@@ -269,6 +271,7 @@ int main(int argc, char** argv) {
   std::string dir = "build/meshes", mesh = "dragon.ply";
   int reps = 10, op_reps = 1;
   bool ops = false, hosts = false;
+  std::vector<std::string> only_ops;  // --op NAME, repeatable
   std::string scale;
   std::vector<char*> rest = {argv[0]};
   for (int i = 1; i < argc; ++i) {
@@ -293,6 +296,12 @@ int main(int argc, char** argv) {
     if (a == "--ops" || a == "--hosts") {
       ops = true;
       hosts |= a == "--hosts";
+      continue;
+    }
+    std::string op_name;
+    if (value("--op", op_name)) {
+      only_ops.push_back(op_name);
+      ops = true;
       continue;
     }
     if (value("--op-reps", reps_text)) {
@@ -348,7 +357,7 @@ int main(int argc, char** argv) {
     return 1;
   }
   std::fflush(stdout);
-  if (ops) return bench::run_operation_table(op_reps, hosts);
+  if (ops) return bench::run_operation_table(op_reps, hosts, only_ops);
 
   bench::CollectingReporter reporter(benchmark::CreateDefaultDisplayReporter());
   benchmark::RunSpecifiedBenchmarks(&reporter);

@@ -398,7 +398,7 @@ void print_table(const std::vector<Row>& rows, const std::string& mesh_name, con
 
 }  // namespace
 
-int run_operation_table(int reps, bool hosts) {
+int run_operation_table(int reps, bool hosts, const std::vector<std::string>& only) {
   const hedge::Soup& soup = input().soup;
   const std::string mesh_name = fs::path(input().path).filename().string();
   Reference ref;
@@ -412,6 +412,7 @@ int run_operation_table(int reps, bool hosts) {
       {"hedge", hedge_operations()}, {"OpenMesh", openmesh_operations()}, {"CGAL", cgal_operations()}};
   std::fprintf(stderr, "operations on %s, %d run(s) each:\n", mesh_name.c_str(), reps);
   for (const char* op : kTableOps) {
+    if (!only.empty() && std::find(only.begin(), only.end(), op) == only.end()) continue;
     for (const auto& [library, entries] : libraries) {
       bool first_hedge = true;
       for (const OpEntry& e : entries) {
