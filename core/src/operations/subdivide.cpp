@@ -688,8 +688,9 @@ Mesh sqrt3_step(const Mesh& m, bool trisect, std::vector<bool>& crease, unsigned
     return Halfedge(2 * (crease_edge0 + 6 * c + which) + side);
   };
   auto is_crease = [&](Edge e) { return creases && crease[e.idx()]; };
-  // Boundary half-edge g is cut on this step; boundary_out(g) is the half-edge that then
-  // leaves g's origin B along the boundary (B -> Q2), g itself otherwise.
+  // is_cut(g): g's edge is a boundary edge cut on this step. boundary_out(g), for a boundary
+  // half-edge g: the half-edge that then leaves g's origin B along the boundary (B -> Q2), g
+  // itself when its edge is not cut.
   auto is_cut = [&](Halfedge g) { return trisect && boundary_number[Mesh::edge(g).idx()] != kInvalidIndex; };
   auto boundary_out = [&](Halfedge g) {
     return is_cut(g) ? extra_halfedge(boundary_number[Mesh::edge(g).idx()], 1, 1) : g;
@@ -793,7 +794,7 @@ Mesh sqrt3_step(const Mesh& m, bool trisect, std::vector<bool>& crease, unsigned
           if (edge_props) emap[Mesh::edge(s1).idx()] = emap[Mesh::edge(s2).idx()] = e.idx();
           continue;
         }
-        if (sharp && !boundary && trisect) {
+        if (trisect && is_crease(e)) {
           // A crease: its side 0 runs A -> Q1 -> Q2 -> B, side 1 B -> Q2 -> Q1 -> A.
           const Index c = crease_number[e.idx()];
           const unsigned side = h == Mesh::halfedge(e, 0) ? 0 : 1;
@@ -801,16 +802,16 @@ Mesh sqrt3_step(const Mesh& m, bool trisect, std::vector<bool>& crease, unsigned
           const Halfedge x = crease_halfedge(c, 2 + 2 * side, 0), y = crease_halfedge(c, 3 + 2 * side, 0);
           const Face t1(crease_face0 + 4 * c + 2 * side), t2(crease_face0 + 4 * c + 2 * side + 1);
           const Index slot = crease_slot0 + 4 * c + 2 * side;
-          if (side == 0)
+          if (side == 0) {
             cut_side(f, i, h,
                      {h, crease_halfedge(c, 0, 0), crease_halfedge(c, 1, 0), x, y, q1, q2, t1, t2, slot, slot + 1});
-          else
-            cut_side(f, i, h,
-                     {crease_halfedge(c, 1, 1), crease_halfedge(c, 0, 1), h, x, y, q2, q1, t1, t2, slot, slot + 1});
-          if (side == 0) {  // the shared elements, written once
+            // The elements both sides share, written once.
             out.set_halfedge(q1, x);
             out.set_halfedge(q2, y);
             if (edge_props) emap[crease_edge0 + 6 * c] = emap[crease_edge0 + 6 * c + 1] = e.idx();
+          } else {
+            cut_side(f, i, h,
+                     {crease_halfedge(c, 1, 1), crease_halfedge(c, 0, 1), h, x, y, q2, q1, t1, t2, slot, slot + 1});
           }
           continue;
         }
@@ -913,10 +914,7 @@ Mesh sqrt3_step(const Mesh& m, bool trisect, std::vector<bool>& crease, unsigned
       // As for Loop: a corner (three or more sharp edges) stays, a vertex on two follows the
       // curve rule along them (here the boundary's), a dart (one) the smooth rule.
       const SharpEdges sharp = sharp_edges(m, crease, v);
-      auto cut = [&](Halfedge h) {
-        const Edge e = Mesh::edge(h);
-        return trisect && (is_crease(e) || boundary_number[e.idx()] != kInvalidIndex);
-      };
+      auto cut = [&](Halfedge h) { return is_cut(h) || (trisect && is_crease(Mesh::edge(h))); };
       if (sharp.count >= 3 || (sharp.count == 2 && (!cut(sharp.out[0]) || !cut(sharp.out[1])))) {
         s.add(v.idx(), 1.0f);
         return;
