@@ -10,31 +10,54 @@
 #   material indices             face "material"            i32
 #   smooth shading               face "smooth"              u8
 #   selection, hiding            "selected", "hidden"       u8, vertex and face
-#   vertex bevel weight          vertex "bevel_weight"      f32
+#   vertex bevel weight (3.x)    vertex "bevel_weight"      f32
 #   vertex identity              vertex "blender:vertex"    i32 (where each result vertex came from)
 #   each vertex group            vertex "vgroup:<name>"     f32 weight (0 where not a member)
 # Edge data (seams, sharp edges, creases, bevel weights, generic edge attributes) has no
 # channel: it is matched back by the pair of source vertices of each result edge.
+#
+# One code for Blender 3.4 to 5.x, chosen by what the running Blender has (never by trying and
+# catching): 4.0 and later keep bevel weights, creases, sharp edges and (5.x) seams as generic
+# attributes (bevel_weight_vert, bevel_weight_edge, crease_vert, crease_edge, sharp_edge,
+# uv_seam), which the generic attribute path carries like any other; 3.x keeps them as
+# properties behind has_* tests. Each datum is read once, by one path.
 import bpy
 import numpy as np
 
 # Blender attribute type -> (foreach property, numpy dtype, components)
+# (the types a Blender does not have never occur in it: INT32_2D, QUATERNION and FLOAT4X4 came in
+# 3.6 and 4.0, INT16_2D and FLOAT4 in 4.4+)
 ATTRIBUTE_TYPES = {
     'FLOAT': ("value", np.float32, 1),
     'INT': ("value", np.int32, 1),
     'FLOAT_VECTOR': ("vector", np.float32, 3),
     'FLOAT2': ("vector", np.float32, 2),
+    'FLOAT4': ("vector", np.float32, 4),
     'FLOAT_COLOR': ("color", np.float32, 4),
     'BYTE_COLOR': ("color_srgb", np.float32, 4),
     'BOOLEAN': ("value", np.bool_, 1),
     'INT8': ("value", np.int8, 1),
+    'INT16_2D': ("value", np.int16, 2),
+    'INT32_2D': ("value", np.int32, 2),
+    'QUATERNION': ("value", np.float32, 4),
+    'FLOAT4X4': ("value", np.float32, 16),
 }
 DOMAINS = {'POINT': "vertex", 'FACE': "face", 'CORNER': "corner"}
 BLENDER_DOMAINS = {v: k for k, v in DOMAINS.items()}
-# Attributes that the mesh API owns under another name (3.4 and later versions).
-RESERVED = {"position", "material_index", "sharp_face", ".corner_vert", ".corner_edge", ".edge_verts"}
+# Attributes that the mesh API owns under another name (3.4 and later versions), and custom
+# normals (4.4+ "custom_normal": encoded, not to be interpolated; reported as not carried).
+RESERVED = {"position", "material_index", "sharp_face", "custom_normal"}
 
-EDGE_FLAGS = (("use_seam", np.bool_), ("use_edge_sharp", np.bool_), ("use_freestyle_mark", np.bool_))
+# Edge flags and the attribute that holds each from 4.0 on. A flag is read as a property only
+# where the running Blender has the property and no visible generic attribute holds it (3.x;
+# 4.x's hidden ".uv_seam"; freestyle marks until 5.0), so it never crosses twice.
+EDGE_FLAGS = (("use_seam", "uv_seam"), ("use_edge_sharp", "sharp_edge"), ("use_freestyle_mark", "freestyle_edge"))
+_EDGE_PROPERTIES = bpy.types.MeshEdge.bl_rna.properties
+# 3.x: bevel weights and creases are properties present when the mesh's has_* says so.
+LEGACY_LAYERS = "has_bevel_weight_vertex" in bpy.types.Mesh.bl_rna.properties
+LEGACY_EDGE_LAYERS = (("has_crease_edge", "crease"), ("has_bevel_weight_edge", "bevel_weight"))
+# 4.0+: node groups declare their sockets through `interface` (3.x: inputs/outputs).
+NODE_INTERFACE = "interface" in bpy.types.NodeTree.bl_rna.properties
 
 
 def _get(collection, prop, n, dtype, components=1):
@@ -148,19 +171,20 @@ def read_mesh(me):
     channels.append(("selected", "face", _get(me.polygons, "select", nf, np.bool_).view(np.uint8)))
     channels.append(("hidden", "vertex", _get(me.vertices, "hide", nv, np.bool_).view(np.uint8)))
     channels.append(("hidden", "face", _get(me.polygons, "hide", nf, np.bool_).view(np.uint8)))
-    if me.has_bevel_weight_vertex:
+    if LEGACY_LAYERS and me.has_bevel_weight_vertex:
         channels.append(("bevel_weight", "vertex", _get(me.vertices, "bevel_weight", nv, np.float32)))
     channels.append(("blender:vertex", "vertex", np.arange(nv, dtype=np.int32)))
 
     d.edges = _get(me.edges, "vertices", ne, np.int32, 2)
-    for prop, dtype in EDGE_FLAGS:
-        values = _get(me.edges, prop, ne, dtype)
-        if values.any():
-            d.edge_data[prop] = values
-    if me.has_crease_edge:
-        d.edge_data["crease"] = _get(me.edges, "crease", ne, np.float32)
-    if me.has_bevel_weight_edge:
-        d.edge_data["bevel_weight"] = _get(me.edges, "bevel_weight", ne, np.float32)
+    for prop, attribute in EDGE_FLAGS:
+        if prop in _EDGE_PROPERTIES and attribute not in me.attributes:
+            values = _get(me.edges, prop, ne, np.bool_)
+            if values.any():
+                d.edge_data[prop] = values
+    if LEGACY_LAYERS:
+        for has, prop in LEGACY_EDGE_LAYERS:
+            if getattr(me, has):
+                d.edge_data[prop] = _get(me.edges, prop, ne, np.float32)
     if me.has_custom_normals:
         d.not_carried.append("custom split normals")
     d.soup = {"positions": positions, "face_sizes": loop_total, "corners": corners, "channels": channels}
@@ -181,8 +205,12 @@ def read_vertex_groups(obj, me, data):
     tree = bpy.data.node_groups.new("hedge vertex groups", 'GeometryNodeTree')
     temp = None
     try:
-        tree.inputs.new('NodeSocketGeometry', "Geometry")
-        tree.outputs.new('NodeSocketGeometry', "Geometry")
+        if NODE_INTERFACE:
+            tree.interface.new_socket("Geometry", in_out='INPUT', socket_type='NodeSocketGeometry')
+            tree.interface.new_socket("Geometry", in_out='OUTPUT', socket_type='NodeSocketGeometry')
+        else:
+            tree.inputs.new('NodeSocketGeometry', "Geometry")
+            tree.outputs.new('NodeSocketGeometry', "Geometry")
         geometry = tree.nodes.new('NodeGroupInput').outputs[0]
         for i, name in enumerate(names):
             read = tree.nodes.new('GeometryNodeInputNamedAttribute')
@@ -242,6 +270,14 @@ def write_vertex_groups(obj, me, data, result):
         obj.vertex_groups.active_index = data.active_group
 
 
+def new_attribute(me, name, data_type, domain):
+    """A fresh attribute `name`, replacing one of that name (never a second one named .001)."""
+    old = me.attributes.get(name)
+    if old is not None:
+        me.attributes.remove(old)
+    return me.attributes.new(name, data_type, domain)
+
+
 def channel(soup, name, domain):
     for n, dom, values in soup["channels"]:
         if n == name and dom == domain:
@@ -299,7 +335,7 @@ def _write_attributes(me, data, result, create, loop_inverse=None):
                 continue
             if create:
                 attr = (me.color_attributes.new(name, data_type, bl_domain) if prefix == "color:"
-                        else me.attributes.new(name, data_type, bl_domain))
+                        else new_attribute(me, name, data_type, bl_domain))
             else:
                 attr = me.attributes.get(name)
             if attr is None:
@@ -359,7 +395,7 @@ def _write_edges(me, data, result):
     for name, data_type in data.edge_attributes:
         values = data.edge_data["attr:" + name]
         prop, dtype, comps = ATTRIBUTE_TYPES[data_type]
-        attr = me.attributes.new(name, data_type, 'EDGE')
+        attr = new_attribute(me, name, data_type, 'EDGE')
         out = np.zeros((ne, comps) if comps > 1 else ne, values.dtype)
         out[found] = values[match[found]]
         _set(attr.data, prop, out)

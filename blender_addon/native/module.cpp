@@ -358,21 +358,33 @@ void write_file(const py::dict& mesh, const std::string& path) {
   write_mesh(soup, path);
 }
 
+// Sets the Python error of a translated exception: py::set_error where pybind11 has it
+// (2.12+; 3.x deprecates calling the exception object), the C API before (Debian 12's 2.10).
+void raise_error(const py::handle& type, const char* message) {
+#if PYBIND11_VERSION_HEX >= 0x020C0000
+  py::set_error(type, message);
+#else
+  PyErr_SetString(type.ptr(), message);
+#endif
+}
+
 }  // namespace
 
 PYBIND11_MODULE(_native, m) {
   m.doc() = "hedge half-edge mesh processing: the operation catalogue on numpy arrays";
-  static py::exception<Error> error_type(m, "Error", PyExc_RuntimeError);
-  static py::exception<Cancelled> cancelled_type(m, "Cancelled", error_type.ptr());
+  // The exception types live as long as the process: released handles, so no static
+  // destructor touches Python after the host has finalized it.
+  static const py::handle error_type = py::exception<Error>(m, "Error", PyExc_RuntimeError).release();
+  static const py::handle cancelled_type = py::exception<Cancelled>(m, "Cancelled", error_type).release();
   py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);
     } catch (const Cancelled& e) {
-      cancelled_type(e.what());
+      raise_error(cancelled_type, e.what());
     } catch (const Error& e) {
-      error_type(e.what());
+      raise_error(error_type, e.what());
     } catch (const std::bad_alloc&) {
-      error_type("out of memory");
+      raise_error(error_type, "out of memory");
     }
   });
   m.def("catalogue", &catalogue_list, "Every operation with its parameters, in menu order.");

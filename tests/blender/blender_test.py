@@ -1,38 +1,43 @@
 # Shared by the Blender tests (run inside `blender -b --factory-startup --python X.py -- ARGS`):
-# arguments, installing and enabling the add-on zip in the private HOME, scene helpers, and a
+# arguments, installing and enabling the package a user of the running Blender installs (the
+# legacy add-on zip before 4.2, the extension after) in the private HOME, scene helpers, and a
 # unittest runner that makes blender exit non-zero (with --python-exit-code) on failure.
 import argparse
 import os
 import sys
 import unittest
 
-import addon_utils
+# No __pycache__ in the source tree (Blender 4.x+ ignores PYTHONDONTWRITEBYTECODE).
+sys.dont_write_bytecode = True
+
 import bpy
 import numpy as np
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "blender_addon", "tools"))
+import hedge_install  # noqa: E402
 
 
 def arguments():
     argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
     parser = argparse.ArgumentParser()
-    parser.add_argument("--zip", required=True, help="build/hedge_blender_addon.zip")
+    parser.add_argument("--addon-zip", required=True, help="build/hedge_blender_addon.zip (Blender 3.4-4.1)")
+    parser.add_argument("--extension-zip", default="", help="build/hedge_blender_extension.zip (Blender 4.2+)")
     parser.add_argument("--meshes", default="", help="folder with bunny.off, dragon*.ply")
     parser.add_argument("--out", default="", help="folder for outputs (screenshots, renders)")
     parser.add_argument("--full", action="store_true", help="also the full 871k-face dragon")
     args, rest = parser.parse_known_args(argv)
     args.rest = rest
+    args.zip = hedge_install.package_for_this_blender(args.addon_zip, args.extension_zip)
     return args
 
 
 ARGS = arguments()
 
 
-def install_addon():
-    """Installs the zip as a user would (Preferences > Add-ons > Install) and enables it."""
-    bpy.ops.preferences.addon_install(filepath=os.path.abspath(ARGS.zip), overwrite=True)
-    addon_utils.modules_refresh()
-    module = addon_utils.enable("hedge", default_set=True, handle_error=None)
-    if module is None:
-        raise RuntimeError("the hedge add-on did not enable")
+def install_addon(zip_path=None):
+    """Installs the zip as a user of this Blender would and enables it; returns the package,
+    which a script then also reaches as `import hedge` (as an extension too)."""
+    hedge_install.install(zip_path or ARGS.zip)
     import hedge
     return hedge
 
@@ -60,30 +65,62 @@ def select_only(obj):
     bpy.context.view_layer.objects.active = obj
 
 
+# Blender's own importers: the C++ ones where this Blender has them (PLY and STL from 3.6,
+# the only ones in 4.0+), the Python add-ons before.
+IMPORTERS = {".ply": ("wm.ply_import", "import_mesh.ply"), ".obj": ("wm.obj_import", "import_scene.obj"),
+             ".stl": ("wm.stl_import", "import_mesh.stl")}
+
+
 def import_mesh(path):
     """Imports PLY/OBJ/STL with Blender's own importers; returns the new object."""
     bpy.ops.object.select_all(action='DESELECT')
     ext = os.path.splitext(path)[1].lower()
-    if ext == ".ply":
-        bpy.ops.import_mesh.ply(filepath=path)
-    elif ext == ".obj":
-        bpy.ops.import_scene.obj(filepath=path)
-    elif ext == ".stl":
-        bpy.ops.import_mesh.stl(filepath=path)
-    else:
+    if ext not in IMPORTERS:
         raise ValueError(f"no Blender importer for {path}")
+    for name in IMPORTERS[ext]:
+        group, op = name.split(".")
+        if op in dir(getattr(bpy.ops, group)):
+            getattr(getattr(bpy.ops, group), op)(filepath=path)
+            break
     obj = bpy.context.selected_objects[0]
     select_only(obj)
     return obj
 
 
+# Data that 3.x keeps as properties and 4.0+ as generic attributes:
+#   key -> (collection, property, attribute, domain)
+LAYERS = {"edge:crease": ("edges", "crease", "crease_edge", 'EDGE'),
+          "edge:bevel_weight": ("edges", "bevel_weight", "bevel_weight_edge", 'EDGE'),
+          "vertex:bevel_weight": ("vertices", "bevel_weight", "bevel_weight_vert", 'POINT')}
+LEGACY_LAYERS = "crease" in bpy.types.MeshEdge.bl_rna.properties
+FREESTYLE_MARKS = "use_freestyle_mark" in bpy.types.MeshEdge.bl_rna.properties
+
+
+def set_layer(me, key, values):
+    """Sets a bevel weight or crease layer (LAYERS) where this Blender keeps it."""
+    collection, prop, attribute, domain = LAYERS[key]
+    if LEGACY_LAYERS:
+        getattr(me, collection).foreach_set(prop, values)
+    else:
+        me.attributes.new(attribute, 'FLOAT', domain).data.foreach_set("value", values)
+
+
+def get(coll, prop, n, dtype, comps=1):
+    a = np.empty(n * comps, dtype)
+    if n:
+        coll.foreach_get(prop, a)
+    return a
+
+
+def is_edge_key(key):
+    """The mesh_arrays entries in edge order (which a rebuild may change)."""
+    return key == "edges" or key.startswith("edge:") or key.endswith(":EDGE")
+
+
 def mesh_arrays(me):
-    """Everything the tests compare, as numpy arrays."""
-    def get(coll, prop, n, dtype, comps=1):
-        a = np.empty(n * comps, dtype)
-        if n:
-            coll.foreach_get(prop, a)
-        return a
+    """Everything the tests compare, as numpy arrays: what the exchange carries, under one key
+    each in every version (3.x properties under their own key, 4.0+ attributes as attr:...)."""
+    from hedge.exchange import ATTRIBUTE_TYPES
     nv, nl, nf, ne = len(me.vertices), len(me.loops), len(me.polygons), len(me.edges)
     out = {
         "co": get(me.vertices, "co", nv, np.float32, 3),
@@ -92,23 +129,26 @@ def mesh_arrays(me):
         "loop_start": get(me.polygons, "loop_start", nf, np.int32),
         "material": get(me.polygons, "material_index", nf, np.int32),
         "smooth": get(me.polygons, "use_smooth", nf, np.bool_),
+        "vertex:select": get(me.vertices, "select", nv, np.bool_),
+        "vertex:hide": get(me.vertices, "hide", nv, np.bool_),
+        "face:select": get(me.polygons, "select", nf, np.bool_),
+        "face:hide": get(me.polygons, "hide", nf, np.bool_),
         "edges": get(me.edges, "vertices", ne, np.int32, 2),
-        "seam": get(me.edges, "use_seam", ne, np.bool_),
-        "sharp": get(me.edges, "use_edge_sharp", ne, np.bool_),
+        "edge:seam": get(me.edges, "use_seam", ne, np.bool_),
+        "edge:sharp": get(me.edges, "use_edge_sharp", ne, np.bool_),
     }
+    if FREESTYLE_MARKS:
+        out["edge:freestyle"] = get(me.edges, "use_freestyle_mark", ne, np.bool_)
+    if LEGACY_LAYERS:
+        for key, (collection, prop, _, _) in LAYERS.items():
+            out[key] = get(getattr(me, collection), prop, ne if collection == "edges" else nv, np.float32)
     for layer in me.uv_layers:
         out["uv:" + layer.name] = get(layer.data, "uv", nl, np.float32, 2)
     for attr in me.attributes:
-        if attr.name.startswith("."):
+        if attr.name.startswith(".") or attr.data_type not in ATTRIBUTE_TYPES:
             continue
-        prop = {"FLOAT": "value", "INT": "value", "FLOAT_VECTOR": "vector", "FLOAT2": "vector",
-                "FLOAT_COLOR": "color", "BYTE_COLOR": "color_srgb", "BOOLEAN": "value", "INT8": "value"}.get(attr.data_type)
-        if prop is None:
-            continue
-        n = len(attr.data)
-        comps = {"FLOAT_VECTOR": 3, "FLOAT2": 2, "FLOAT_COLOR": 4, "BYTE_COLOR": 4}.get(attr.data_type, 1)
-        dtype = {"INT": np.int32, "BOOLEAN": np.bool_, "INT8": np.int8}.get(attr.data_type, np.float32)
-        out[f"attr:{attr.name}:{attr.domain}"] = get(attr.data, prop, n, dtype, comps)
+        prop, dtype, comps = ATTRIBUTE_TYPES[attr.data_type]
+        out[f"attr:{attr.name}:{attr.domain}"] = get(attr.data, prop, len(attr.data), dtype, comps)
     return out
 
 

@@ -1,22 +1,39 @@
-# The add-on zip installs and enables in blender -b; the native module exposes the catalogue;
-# every catalogue operation is an operator mesh.hedge_<id> with its parameters as properties.
+# The package installs and enables in blender -b as a user of this Blender installs it (the
+# legacy zip before 4.2, the extension after); the native module for this Python loads and
+# exposes the catalogue; every catalogue operation is an operator mesh.hedge_<id> with its
+# parameters as properties; `import hedge` reaches the batch API in every version.
 import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import bpy  # noqa: E402
-from blender_test import add_primitive, clear_scene, install_addon, run_tests  # noqa: E402
+from blender_test import add_primitive, clear_scene, hedge_install, install_addon, run_tests  # noqa: E402
 import unittest  # noqa: E402
 
 hedge = install_addon()
 
 
 class AddonTest(unittest.TestCase):
-    def test_installed_in_user_scripts(self):
-        path = os.path.join(bpy.utils.user_resource('SCRIPTS'), "addons", "hedge")
+    def test_installed_in_user_folder(self):
+        path = hedge_install.installed_folder()
         self.assertTrue(os.path.isdir(path), path)
-        self.assertTrue(any(f.startswith("_native") and f.endswith(".so") for f in os.listdir(path)))
+        files = os.listdir(path)
+        # One module per Python built for; this Blender's among them, and loaded.
+        modules = [f for f in files if f.startswith("_native.cpython-") and f.endswith(".so")]
+        tag = f"cpython-{sys.version_info.major}{sys.version_info.minor}-"
+        self.assertTrue(any(tag in f for f in modules), modules)
         self.assertIsNotNone(hedge.native.native, hedge.native.load_error)
+        self.assertIn(tag, hedge.native.native.__file__)
+        self.assertEqual("blender_manifest.toml" in files, hedge_install.EXTENSIONS)
+        self.assertEqual(hedge.__name__, hedge_install.MODULE)
+        self.assertTrue(os.path.samefile(os.path.dirname(hedge.__file__), path))
+
+    def test_import_hedge_is_the_package(self):
+        import hedge as by_name
+        from hedge import api
+        self.assertIs(by_name, sys.modules[hedge_install.MODULE])
+        self.assertIs(api, sys.modules[hedge_install.MODULE + ".api"])
+        self.assertIs(by_name.run, api.run)
 
     def test_operator_per_operation(self):
         ids = [op["id"] for op in hedge.catalogue()]
@@ -50,11 +67,15 @@ class AddonTest(unittest.TestCase):
 
     def test_disable_enable(self):
         import addon_utils
-        addon_utils.disable("hedge")
+        addon_utils.disable(hedge_install.MODULE)
         self.assertNotIn("hedge_decimate", dir(bpy.ops.mesh))
         self.assertFalse(hasattr(bpy.types, "VIEW3D_PT_hedge"))
-        addon_utils.enable("hedge", default_set=True, handle_error=None)
+        if hedge_install.EXTENSIONS:
+            self.assertNotIn("hedge", sys.modules)  # the alias goes with the extension
+        hedge_install.enable()
         self.assertIn("hedge_decimate", dir(bpy.ops.mesh))
+        import hedge as again
+        self.assertIs(again, sys.modules[hedge_install.MODULE])
 
     def test_decimate_sphere(self):
         clear_scene()

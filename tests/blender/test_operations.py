@@ -195,7 +195,7 @@ class PrimitivesTest(unittest.TestCase):
         bpy.ops.mesh.hedge_smooth(method='taubin', iterations=5)
         after = mesh_arrays(obj.data)
         self.assertFalse(np.array_equal(before["co"], after["co"]))
-        for key in ("loop_vertex", "loop_total", "edges", "seam", "material", "uv:UVMap"):
+        for key in ("loop_vertex", "loop_total", "edges", "edge:seam", "material", "uv:UVMap"):
             self.assertTrue(np.array_equal(before[key], after[key]), key)
         self.assertEqual(obj.vertex_groups["left"].weight(150), 0.75)
 

@@ -1,7 +1,9 @@
 # The exchange bpy.types.Mesh <-> hedge: a no-op round trip (read, build, extract, write the
-# geometry anew) leaves positions, loops, polygons, UVs, attributes, flags and edge data
-# identical; figures for the exchange on the full dragon.
+# geometry anew) leaves positions, loops, polygons, UVs, attributes of every type this Blender
+# has, flags, bevel weights, creases and edge data identical, adds no attribute (no
+# sharp_edge.001); figures for the exchange on the full dragon.
 import os
+import re
 import sys
 import time
 
@@ -9,11 +11,17 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 import unittest  # noqa: E402
-from blender_test import ARGS, add_primitive, clear_scene, install_addon, mesh_arrays, run_tests  # noqa: E402
+from blender_test import (ARGS, FREESTYLE_MARKS, LAYERS, add_primitive, clear_scene, install_addon,  # noqa: E402
+                          is_edge_key, mesh_arrays, run_tests, set_layer)
 
 hedge = install_addon()
 from hedge import exchange  # noqa: E402
 from hedge.native import native  # noqa: E402
+
+# One attribute of each type this Blender has that the exchange carries, domains in turn.
+DATA_TYPES = [t.identifier for t in bpy.types.Attribute.bl_rna.properties["data_type"].enum_items
+              if t.identifier in exchange.ATTRIBUTE_TYPES and "COLOR" not in t.identifier]
+DOMAIN_CYCLE = ('POINT', 'FACE', 'CORNER', 'EDGE')
 
 
 def decorate(obj):
@@ -23,36 +31,52 @@ def decorate(obj):
     rng = np.random.default_rng(7)
     me.uv_layers.new(name="second")
     me.uv_layers["second"].data.foreach_set("uv", rng.random(nl * 2, np.float32))
-    specs = [("f_point", 'FLOAT', 'POINT', "value", 1), ("i_face", 'INT', 'FACE', "value", 1),
-             ("v_corner", 'FLOAT_VECTOR', 'CORNER', "vector", 3), ("uv2_point", 'FLOAT2', 'POINT', "vector", 2),
-             ("b_face", 'BOOLEAN', 'FACE', "value", 1), ("i8_point", 'INT8', 'POINT', "value", 1),
-             ("f_edge", 'FLOAT', 'EDGE', "value", 1)]
     sizes = {'POINT': nv, 'FACE': nf, 'CORNER': nl, 'EDGE': ne}
-    for name, data_type, domain, prop, comps in specs:
-        attr = me.attributes.new(name, data_type, domain)
+    for i, data_type in enumerate(DATA_TYPES):
+        domain = DOMAIN_CYCLE[i % len(DOMAIN_CYCLE)]
+        prop, dtype, comps = exchange.ATTRIBUTE_TYPES[data_type]
         n = sizes[domain] * comps
-        values = {'INT': rng.integers(-1000, 1000, n).astype(np.int32), 'BOOLEAN': rng.random(n) < 0.5,
-                  'INT8': rng.integers(-100, 100, n).astype(np.int8)}.get(data_type, rng.random(n, np.float32))
-        attr.data.foreach_set(prop, values)
+        if dtype == np.bool_:
+            values = rng.random(n) < 0.5
+        elif np.issubdtype(dtype, np.integer):
+            values = rng.integers(-100, 100, n).astype(dtype)
+        else:
+            values = rng.random(n, np.float32)
+        me.attributes.new(f"{data_type.lower()}_{domain.lower()}", data_type, domain).data.foreach_set(prop, values)
+    me.attributes.new("f_edge", 'FLOAT', 'EDGE').data.foreach_set("value", rng.random(ne, np.float32))
     col = me.color_attributes.new("vcol", 'FLOAT_COLOR', 'POINT')
     col.data.foreach_set("color", rng.random(nv * 4, np.float32))
     byte = me.color_attributes.new("bcol", 'BYTE_COLOR', 'CORNER')
     byte.data.foreach_set("color_srgb", rng.integers(0, 256, nl * 4).astype(np.float32) / 255)
     me.polygons.foreach_set("material_index", rng.integers(0, 3, nf).astype(np.int32))
     me.polygons.foreach_set("use_smooth", rng.random(nf) < 0.5)
+    for collection, n in ((me.vertices, nv), (me.polygons, nf)):
+        collection.foreach_set("select", rng.random(n) < 0.5)
+        collection.foreach_set("hide", rng.random(n) < 0.2)
     me.edges.foreach_set("use_seam", rng.random(ne) < 0.2)
     me.edges.foreach_set("use_edge_sharp", rng.random(ne) < 0.2)
-    me.edges.foreach_set("crease", rng.random(ne, np.float32))
+    if FREESTYLE_MARKS:
+        me.edges.foreach_set("use_freestyle_mark", rng.random(ne) < 0.2)
+    for key, (collection, _, _, _) in LAYERS.items():
+        set_layer(me, key, rng.random(len(getattr(me, collection)), np.float32))
     me.update()
 
 
-def edge_table(me, arrays):
+def edge_table(arrays):
     """Edges as a sorted (min, max) table with their data, independent of edge order."""
     e = np.sort(arrays["edges"].reshape(-1, 2), axis=1)
     order = np.lexsort((e[:, 1], e[:, 0]))
-    crease = np.empty(len(me.edges), np.float32)
-    me.edges.foreach_get("crease", crease)
-    return e[order], arrays["seam"][order], arrays["sharp"][order], crease[order], arrays["attr:f_edge:EDGE"][order]
+    n = len(e)
+    return {key: values.reshape(n, -1)[order] if key != "edges" else e[order]
+            for key, values in arrays.items() if is_edge_key(key)}
+
+
+def attribute_names(me):
+    """The visible attributes (Blender adds internal ".name" ones as it likes, e.g. 5.x's UV
+    selection), and none made twice (".001")."""
+    names = sorted(a.name for a in me.attributes)
+    assert not [n for n in names if re.search(r"\.\d\d\d$", n)], names
+    return [n for n in names if not n.startswith(".")]
 
 
 class RoundTripTest(unittest.TestCase):
@@ -62,27 +86,36 @@ class RoundTripTest(unittest.TestCase):
     def check_round_trip(self, obj):
         me = obj.data
         before = mesh_arrays(me)
-        edges_before = edge_table(me, before)
+        names_before = attribute_names(me)
         data = exchange.read_mesh(me)
         result = native.build_extract(data.soup)
         self.assertTrue(exchange.same_topology(data.soup, result))
         exchange.write_mesh(me, data, result, rebuild=True)
         after = mesh_arrays(me)
         self.assertEqual(sorted(before), sorted(after))
+        self.assertEqual(attribute_names(me), names_before)
         for key in before:
-            if key in ("edges", "seam", "sharp", "attr:f_edge:EDGE"):
+            if is_edge_key(key):
                 continue
             self.assertEqual(before[key].dtype, after[key].dtype, key)
             self.assertTrue(np.array_equal(before[key], after[key]), key)
-        for a, b in zip(edges_before, edge_table(me, after)):
-            self.assertTrue(np.array_equal(a, b))
+        edges_before, edges_after = edge_table(before), edge_table(after)
+        for key in edges_before:
+            self.assertEqual(edges_before[key].dtype, edges_after[key].dtype, key)
+            self.assertTrue(np.array_equal(edges_before[key], edges_after[key]), key)
         self.assertEqual([l.name for l in me.uv_layers], ["UVMap", "second"])
         self.assertEqual(me.uv_layers.active.name, "UVMap")
+        return before
 
     def test_suzanne(self):
         obj = add_primitive("monkey")
         decorate(obj)
-        self.check_round_trip(obj)
+        before = self.check_round_trip(obj)
+        # What was decorated is there to compare (not all zeros or all False).
+        keys = ["edge:seam", "edge:sharp", "vertex:select", "face:hide"] + (["edge:freestyle"] if FREESTYLE_MARKS else [])
+        keys += list(LAYERS) if "edge:crease" in before else [f"attr:{a}:{d}" for _, _, a, d in LAYERS.values()]
+        for key in keys:
+            self.assertTrue(before[key].any(), key)
 
     def test_polygons_and_cylinder(self):
         obj = add_primitive("cylinder", vertices=40)
