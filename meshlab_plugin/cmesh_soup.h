@@ -2,11 +2,10 @@
 // vcg/MeshModel code with no plugin interface in it, so every MeshLab glue version shares it.
 #pragma once
 
-#include <common/meshmodel.h>
-
 #include <cstddef>
 
 #include "hedge/soup.h"
+#include "meshlab_api.h"
 
 namespace hedge::meshlab {
 

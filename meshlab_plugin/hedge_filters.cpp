@@ -7,13 +7,19 @@
 #include <climits>
 #include <cmath>
 #include <new>
+#include <type_traits>
+#include <variant>
 
 #include "cmesh_soup.h"
 #include "hedge/error.h"
 
 namespace hedge::meshlab {
 
+const Operation& operation_at(int id) { return catalogue().at(static_cast<std::size_t>(id)); }
+
 QString filter_name(const Operation& op) { return QString::fromStdString("Hedge: " + op.title); }
+
+QString python_filter_name(const Operation& op) { return QString::fromStdString("hedge_" + op.id); }
 
 QString filter_info(const Operation& op) {
   QString html = QString::fromStdString(op.help).toHtmlEscaped();
@@ -28,6 +34,14 @@ int filter_class(const Operation& op) {
   if (op.category == "Smoothing") return 0x00080;
   if (op.category == "Measure") return 0x10000;
   return 0x00000;  // Generic
+}
+
+int precondition_mask(const Operation&) { return MeshModel::MM_FACENUMBER; }
+
+int postcondition_mask(const Operation& op) {
+  // The mesh is rebuilt. Attribute changes need no bits here: MeshLab compares the data masks
+  // before and after, and colour bits would make the GUI render colours the mesh may not have.
+  return op.changes_mesh ? MeshModel::MM_GEOMETRY_AND_TOPOLOGY_CHANGE : MeshModel::MM_NONE;
 }
 
 RichKind rich_kind(const ParamSpec& spec) {
@@ -68,6 +82,57 @@ QString param_tooltip(const ParamSpec& spec) {
 
 int int_bound(double bound) { return static_cast<int>(std::clamp(bound, double(INT_MIN), double(INT_MAX))); }
 
+void add_parameters(const Operation& op, RichParameterList& parameters) {
+  for (const ParamSpec& spec : op.params) {
+    const QString name = QString::fromStdString(spec.id), label = QString::fromStdString(spec.label);
+    const QString tooltip = param_tooltip(spec);
+    switch (rich_kind(spec)) {
+      case RichKind::boolean:
+        parameters.addParam(RichBool(name, spec.default_value != 0, label, tooltip));
+        break;
+      case RichKind::integer:
+        parameters.addParam(RichInt(name, int_bound(spec.default_value), label, tooltip));
+        break;
+      case RichKind::real:
+        parameters.addParam(RichFloat(name, static_cast<float>(spec.default_value), label, tooltip));
+        break;
+      case RichKind::bounded_real:
+        parameters.addParam(RichDynamicFloat(name, static_cast<float>(spec.default_value), static_cast<float>(spec.min),
+                                             static_cast<float>(spec.max), label, tooltip));
+        break;
+      case RichKind::choice: {
+        QStringList choices;
+        for (const std::string& choice : spec.choices) choices << QString::fromStdString(choice);
+        parameters.addParam(RichEnum(name, static_cast<int>(spec.default_value), choices, label, tooltip));
+        break;
+      }
+    }
+  }
+}
+
+std::map<std::string, Value> given_values(const Operation& op, const RichParameterList& parameters) {
+  std::map<std::string, Value> given;
+  for (const ParamSpec& spec : op.params) {
+    const QString name = QString::fromStdString(spec.id);
+    if (!parameters.hasParameter(name)) continue;
+    const ::Value& value = parameters.getParameterByName(name).value();
+#if HEDGE_MESHLAB_FILTER_PLUGIN
+    const bool integer = value.isInt();  // 2022+ holds an enum's index as an int value
+#else
+    const bool integer = value.isEnum() || value.isInt();
+#endif
+    if (value.isBool())
+      given[spec.id] = value.getBool();
+    else if (integer)
+      given[spec.id] = static_cast<std::int64_t>(value.getInt());
+    else if (value.isFloat())
+      given[spec.id] = real_from_float(value.getFloat());
+    else
+      given[spec.id] = value.typeName().toStdString();  // a type hedge never declares: refused by name
+  }
+  return given;
+}
+
 double real_from_float(float value) {
   char text[32];
   auto written = std::to_chars(text, text + sizeof text, value);
@@ -76,8 +141,26 @@ double real_from_float(float value) {
   return exact;
 }
 
-QStringList run_on_model(const Operation& op, const std::map<std::string, Value>& given, MeshModel& model,
-                         vcg::CallBackPos* cb) {
+namespace {
+
+QVariant variant_of(const Value& value) {
+  return std::visit(
+      [](const auto& v) -> QVariant {
+        using T = std::decay_t<decltype(v)>;
+        if constexpr (std::is_same_v<T, std::string>)
+          return QString::fromStdString(v);
+        else if constexpr (std::is_same_v<T, std::int64_t>)
+          return QVariant(static_cast<qlonglong>(v));
+        else
+          return QVariant(v);
+      },
+      value);
+}
+
+}  // namespace
+
+ModelRun run_on_model(const Operation& op, const std::map<std::string, Value>& given, MeshModel& model,
+                      vcg::CallBackPos* cb) {
   const QString name = filter_name(op);
   const ParamValues values = resolve_params(op, given);  // refuses out-of-range values before any work
 
@@ -107,8 +190,8 @@ QStringList run_on_model(const Operation& op, const std::map<std::string, Value>
   RunResult result = run_operation(op, input, values, progress);
   double write_seconds = 0;
 
-  QStringList lines;
-  auto line = [&](const std::string& s) { lines << name + ": " + QString::fromStdString(s); };
+  ModelRun run;
+  auto line = [&](const std::string& s) { run.lines << name + ": " + QString::fromStdString(s); };
   if (op.changes_mesh) {
     MeshWriteReport written;
     try {
@@ -129,12 +212,24 @@ QStringList run_on_model(const Operation& op, const std::map<std::string, Value>
       line(std::to_string(written.polygons_triangulated) + " polygons stored as triangle fans with faux edges");
     if (written.edges_dropped) line(std::to_string(written.edges_dropped) + " edge elements (wireframe) dropped");
   }
-  for (const auto& [key, value] : result.report.entries) line(key + " = " + value_text(value));
-  for (const auto& message : result.report.messages) line(message);
+  for (const auto& [key, value] : result.report.entries) {
+    line(key + " = " + value_text(value));
+    run.report[key] = variant_of(value);
+  }
+  QStringList messages;
+  for (const auto& message : result.report.messages) {
+    line(message);
+    messages << QString::fromStdString(message);
+  }
+  if (!messages.isEmpty()) run.report["messages"] = messages;
   // The cost of the translation CMeshO <-> Soup, next to the operation's own "seconds".
   line("meshlab_read_seconds = " + value_text(read_seconds));
-  if (op.changes_mesh) line("meshlab_write_seconds = " + value_text(write_seconds));
-  return lines;
+  run.report["meshlab_read_seconds"] = read_seconds;
+  if (op.changes_mesh) {
+    line("meshlab_write_seconds = " + value_text(write_seconds));
+    run.report["meshlab_write_seconds"] = write_seconds;
+  }
+  return run;
 }
 
 }  // namespace hedge::meshlab
