@@ -1,5 +1,7 @@
-"""Shared helpers of the MeshLab host tests: a private X server and HOME, the PREFIX copy of
-meshlabserver, .mlx scripts generated from the catalogue, and results read back with the hedge CLI."""
+"""Shared helpers of the MeshLab host tests: a private X server and HOME, the "runner" that
+applies .mlx scripts (meshlabserver from the PREFIX copy for 2020.09; hedge-mlx, MeshLab's own
+library, for 2021.05+, run inside the version's Debian root), .mlx scripts generated from the
+catalogue, and results read back with the hedge CLI."""
 import argparse
 import json
 import os
@@ -13,17 +15,34 @@ from xml.sax.saxutils import quoteattr
 
 def parse_args(extra=None):
     parser = argparse.ArgumentParser()
-    parser.add_argument("--prefix", required=True, help="PREFIX holding bin/meshlabserver (scripts/install_meshlab --prefix)")
+    parser.add_argument("--runner", choices=("meshlabserver", "hedge-mlx"), default="meshlabserver",
+                        help="what applies the scripts: meshlabserver (MeshLab 2020.09) or hedge-mlx (2021.05+)")
+    parser.add_argument("--prefix", help="meshlabserver: PREFIX holding bin/meshlabserver (scripts/install_meshlab --prefix)")
+    parser.add_argument("--mlx", help="hedge-mlx: the runner built for this MeshLab version")
+    parser.add_argument("--plugin", help="hedge-mlx: libfilter_hedge.so built for this MeshLab version")
     parser.add_argument("--hedge", required=True, help="the hedge CLI")
-    parser.add_argument("--catalogue", required=True, help="hedge_meshlab_catalogue (the catalogue as JSON)")
+    parser.add_argument("--catalogue", required=True,
+                        help="hedge_meshlab_catalogue (the catalogue as JSON), or the JSON file it wrote")
     parser.add_argument("--meshes", required=True, help="real meshes (scripts/fetch_meshes)")
     parser.add_argument("--out", required=True, help="folder for this test's files")
     for name, kwargs in (extra or {}).items():
         parser.add_argument(name, **kwargs)
     args = parser.parse_args()
-    for name in ("prefix", "hedge", "catalogue", "meshes", "out"):
-        setattr(args, name, os.path.abspath(getattr(args, name)))
+    needed = ("prefix",) if args.runner == "meshlabserver" else ("mlx", "plugin")
+    for name in needed:
+        if not getattr(args, name):
+            parser.error(f"--runner {args.runner} needs --{name}")
+    for name in ("prefix", "mlx", "plugin", "hedge", "catalogue", "meshes", "out"):
+        if getattr(args, name):
+            setattr(args, name, os.path.abspath(getattr(args, name)))
     return args
+
+
+def read_catalogue(tool_or_json):
+    if tool_or_json.endswith(".json"):
+        with open(tool_or_json) as f:
+            return json.load(f)
+    return json.loads(subprocess.run([tool_or_json], check=True, capture_output=True, text=True).stdout)
 
 
 class Failure(Exception):
@@ -78,44 +97,87 @@ class XServer:
 
 
 class MeshLab:
-    """meshlabserver and meshlab from PREFIX, with a private HOME (a ~/.config/VCG written by
-    the GUI changes meshlabserver's behaviour) and our own X server."""
+    """The MeshLab under test with a private HOME (a ~/.config/VCG written by the GUI changes
+    meshlabserver's behaviour) and, when the runner or the test needs one, our own X server.
 
-    def __init__(self, args):
+    runner "meshlabserver": MeshLab 2020.09's meshlabserver and meshlab from PREFIX; a failed
+    filter exits 255. runner "hedge-mlx": hedge-mlx with MeshLab's system plugins and ours (by
+    --plugins, shadowing any installed copy), no X server; the GUI is the system meshlab with our
+    plugin installed into the private HOME as a user does; a failed filter exits 1."""
+
+    def __init__(self, args, need_x=False):
         self.args = args
+        self.runner = args.runner
         self.out = os.path.abspath(args.out)
         shutil.rmtree(self.out, ignore_errors=True)
         os.makedirs(self.out)
         self.home = os.path.join(self.out, "home")
         os.makedirs(self.home, mode=0o700)
-        self.server = os.path.join(args.prefix, "bin", "meshlabserver")
-        self.gui = os.path.join(args.prefix, "bin", "meshlab")
-        if not os.access(self.server, os.X_OK):
-            raise Failure(f"{self.server} is missing: run scripts/install_meshlab --prefix {args.prefix} PLUGIN")
-        self.x = XServer()
-        self.catalogue = json.loads(subprocess.run([args.catalogue], check=True, capture_output=True, text=True).stdout)
+        if self.runner == "meshlabserver":
+            self.server = os.path.join(args.prefix, "bin", "meshlabserver")
+            self.gui = os.path.join(args.prefix, "bin", "meshlab")
+            if not os.access(self.server, os.X_OK):
+                raise Failure(f"{self.server} is missing: run scripts/install_meshlab --prefix {args.prefix} PLUGIN")
+            self.filter_failed = 255
+            self.version = "2020.09"
+        else:
+            self.server = args.mlx
+            self.gui = "/usr/bin/meshlab"
+            if not os.access(self.server, os.X_OK):
+                raise Failure(f"{self.server} is missing: build it (cmake --build BUILD --target hedge_mlx_<version>)")
+            self.filter_failed = 1
+            self.version = os.path.basename(os.path.dirname(args.mlx)).removeprefix("meshlab-")
+        self.x = XServer() if self.runner == "meshlabserver" or need_x else None
+        self.catalogue = read_catalogue(args.catalogue)
         self.operations = {op["id"]: op for op in self.catalogue["operations"]}
+        self.dump = None
 
     def close(self):
-        self.x.close()
+        if self.x:
+            self.x.close()
 
     def env(self):
-        env = dict(os.environ, HOME=self.home, DISPLAY=self.x.display, XDG_RUNTIME_DIR=self.home)
+        env = dict(os.environ, HOME=self.home, XDG_RUNTIME_DIR=self.home)
+        if self.x:
+            env["DISPLAY"] = self.x.display
         env.pop("QT_QPA_PLATFORM", None)
         return env
 
     def run_server(self, arguments, timeout=900):
-        """Runs meshlabserver; returns (exit code, output, seconds)."""
+        """Runs the runner with `arguments` as they are; returns (exit code, output, seconds)."""
+        command = [self.server] + arguments
+        if self.runner == "hedge-mlx":
+            command = [self.server, "--plugins", os.path.dirname(self.args.plugin)] + arguments
         start = time.monotonic()
         try:
-            done = subprocess.run([self.server] + arguments, env=self.env(), capture_output=True, text=True,
-                                  errors="replace", timeout=timeout, cwd=self.out)
+            done = subprocess.run(command, env=self.env(), capture_output=True, text=True, errors="replace",
+                                  timeout=timeout, cwd=self.out)
         except subprocess.TimeoutExpired as e:
-            raise Failure(f"meshlabserver {' '.join(arguments)} took more than {timeout} s") from e
+            raise Failure(f"{os.path.basename(self.server)} {' '.join(arguments)} took more than {timeout} s") from e
         seconds = time.monotonic() - start
         return done.returncode, done.stdout + done.stderr, seconds
 
-    def apply(self, mesh_in, mesh_out, filters, name, save_flags=None, timeout=900):
+    def arguments(self, mesh_in, mesh_out, script, save_flags=None):
+        """The runner's arguments to load mesh_in, run script (None: no filter) and save mesh_out
+        (None: no save) with the meshlabserver -m flags save_flags."""
+        if self.runner == "meshlabserver":
+            arguments = ["-i", mesh_in]
+            if mesh_out:
+                arguments += ["-o", mesh_out] + (["-m"] + save_flags if save_flags else [])
+            return arguments + (["-s", script] if script else [])
+        if script is None:
+            script = os.path.join(self.out, "empty.mlx")
+            with open(script, "w") as f:
+                f.write(mlx(self, []))
+        return (["-m"] + save_flags if save_flags else []) + [mesh_in, mesh_out or "-", script]
+
+    def convert(self, mesh_in, mesh_out, save_flags=None, timeout=900):
+        """Loads and saves with no filter. Returns (exit code, output, seconds)."""
+        if os.path.exists(mesh_out):
+            os.remove(mesh_out)
+        return self.run_server(self.arguments(mesh_in, mesh_out, None, save_flags), timeout)
+
+    def apply(self, mesh_in, mesh_out, filters, name, save_flags=None, timeout=900, extra=()):
         """Writes the .mlx for `filters` (see mlx()), runs it on mesh_in, saving to mesh_out.
         Returns (exit code, output, seconds)."""
         script = os.path.join(self.out, name + ".mlx")
@@ -123,16 +185,44 @@ class MeshLab:
             f.write(mlx(self, filters))
         if mesh_out and os.path.exists(mesh_out):
             os.remove(mesh_out)
-        arguments = ["-i", mesh_in]
-        if mesh_out:
-            arguments += ["-o", mesh_out]
-            if save_flags:
-                arguments += ["-m"] + save_flags
-        arguments += ["-s", script]
-        code, output, seconds = self.run_server(arguments, timeout)
+        code, output, seconds = self.run_server(list(extra) + self.arguments(mesh_in, mesh_out, script, save_flags),
+                                                timeout)
         with open(os.path.join(self.out, name + ".log"), "w") as f:
             f.write(output)
         return code, output, seconds
+
+    def filters(self):
+        """Every filter the runner has loaded: {name: {"info", "params": [{"type" (Rich...),
+        "name", "label", "tooltip"}], and with hedge-mlx "python_name", "class", "arity",
+        "preconditions", "postcondition"}}."""
+        if self.runner == "meshlabserver":
+            dump = self.path("filters.txt")
+            code, output, _ = self.run_server(["-d", dump])
+            if code != 0:
+                raise Failure(f"meshlabserver -d exits {code}: {output[-2000:]}")
+            return parse_doxygen_dump(open(dump, encoding="utf-8", errors="replace").read())
+        code, output, _ = self.list_filters()
+        if code != 0:
+            raise Failure(f"hedge-mlx --list exits {code}: {output[-2000:]}")
+        return {f["name"]: dict(f, params=[{"type": p["type"], "name": p["name"], "label": p["description"],
+                                             "tooltip": p["tooltip"]} for p in f["parameters"]])
+                for f in json.loads(output)["filters"]}
+
+    def list_filters(self, plugins=True):
+        """hedge-mlx --list on the bunny (stdout only: the JSON); with plugins=False only the
+        default folders (system, the user's MeshLabExtraPlugins). Returns (code, stdout, stderr)."""
+        command = [self.server] + (["--plugins", os.path.dirname(self.args.plugin)] if plugins else [])
+        done = subprocess.run(command + ["--list", self.mesh("bunny.off")], env=self.env(), capture_output=True,
+                              text=True, errors="replace", cwd=self.out, timeout=300)
+        with open(self.path("list.json" if plugins else "list_installed.json"), "w") as f:
+            f.write(done.stdout)
+        return done.returncode, done.stdout, done.stderr
+
+    def install_for_user(self):
+        """scripts/install_meshlab --user into the private HOME (hedge-mlx runner: the GUI, and
+        hedge-mlx without --plugins, load it from there)."""
+        script = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "scripts", "install_meshlab")
+        return subprocess.run([script, "--user", "--home", self.home, self.args.plugin], capture_output=True, text=True)
 
     def path(self, name):
         return os.path.join(self.out, name)
@@ -152,6 +242,28 @@ class MeshLab:
         if done.returncode != 0:
             raise Failure(f"hedge report {path}: {done.stderr.strip()}")
         return json.loads(done.stdout)
+
+
+def parse_doxygen_dump(text):
+    """meshlabserver -d's doxygen dump as filters(): {name: {"info", "params"}}."""
+    filters = {}
+    sections = re.split(r"\n\\section f\d+ ", "\n" + text)
+    for section in sections[1:]:
+        name, _, rest = section.partition(" \n")
+        info, _, params_text = rest.partition("<H2> Parameters </h2>")
+        rows = re.findall(r"<TR><TD> \\c (\w+)  </TD> <TD> (.*?) </TD> <TD><i> (.*?) -- </i></TD> </TR>", params_text, re.S)
+        filters[name.strip()] = {"info": info.strip(), "params": [{"type": "Rich" + rich, "name": None, "label": label,
+                                                                    "tooltip": tooltip} for rich, label, tooltip in rows]}
+    return filters
+
+
+def result_of(output, filter_name):
+    """What hedge-mlx printed as the filter's returned map (RESULT: name: {...}), last run; None if none."""
+    found = None
+    for line in output.splitlines():
+        if line.startswith(f"RESULT: {filter_name}: "):
+            found = json.loads(line[len(f"RESULT: {filter_name}: "):])
+    return found
 
 
 def hedge_filter(meshlab, op_id, **values):
