@@ -7,9 +7,6 @@ import os
 import sys
 import unittest
 
-# No __pycache__ in the source tree (Blender 4.x+ ignores PYTHONDONTWRITEBYTECODE).
-sys.dont_write_bytecode = True
-
 import bpy
 import numpy as np
 

@@ -5,6 +5,8 @@
 #   xvfb-run -a -s "-screen 0 1600x1000x24" blender --factory-startup --enable-event-simulate \
 #            --python test_gui.py -- --zip ZIP --out DIR
 import os
+import shutil
+import subprocess
 import sys
 import time
 import traceback
@@ -59,11 +61,24 @@ def region(area, kind):
 
 
 def screenshot(name):
-    win, area = view3d()
+    """The X server's own pixels (imagemagick's `import`; under Xvfb bpy's screenshot is all
+    black in 4.3 and 5.2), or bpy's where there is no `import`. A blank picture fails."""
     path = os.path.join(ARGS.out, name)
-    with bpy.context.temp_override(window=win, area=area):
-        bpy.ops.screen.screenshot(filepath=path)
-    log(f"screenshot {path} ({os.path.getsize(path)} bytes)")
+    if shutil.which("import"):
+        subprocess.run(["import", "-window", "root", path], check=True, timeout=60)
+    else:
+        win, area = view3d()
+        with bpy.context.temp_override(window=win, area=area):
+            bpy.ops.screen.screenshot(filepath=path)
+    image = bpy.data.images.load(path)
+    try:
+        pixels = np.empty(len(image.pixels), np.float32)
+        image.pixels.foreach_get(pixels)
+    finally:
+        bpy.data.images.remove(image)
+    spread = float(pixels.reshape(-1, 4)[:, :3].std())
+    log(f"screenshot {path} ({os.path.getsize(path)} bytes, colour spread {spread:.3f})")
+    assert spread > 0.02, f"{name} is blank"
 
 
 def click(win, x, y):
