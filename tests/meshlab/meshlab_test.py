@@ -279,6 +279,16 @@ def hedge_filter(meshlab, op_id, **values):
     return op["filter"], params
 
 
+def hedge_filter_given(meshlab, op_id, **values):
+    """A Hedge filter with only the parameters given (2021.05+ runners take defaults for the rest)."""
+    op = meshlab.operations[op_id]
+    by_id = {p["id"]: p for p in op["params"]}
+    unknown = set(values) - set(by_id)
+    if unknown:
+        raise Failure(f"{op_id} has no parameters {sorted(unknown)}")
+    return op["filter"], [param_xml(by_id[k], v) for k, v in values.items()]
+
+
 def default_value(p):
     if p["type"] == "bool":
         return bool(p["default"])

@@ -1,7 +1,10 @@
-"""Bad input through meshlabserver: non-manifold meshes (a real scan with non-manifold edges
-and vertices, and a small mesh made of every kind of trouble) go through every Hedge filter
-without a crash; parameter values out of range are refused with the catalogue's message (the
-CLI's), in MeshLab's log, with exit 255 and no output written."""
+"""Bad input through the runner (meshlabserver, hedge-mlx): non-manifold meshes (a real scan with
+non-manifold edges and vertices, and a small mesh made of every kind of trouble) go through every
+Hedge filter without a crash; parameter values out of range are refused with the catalogue's
+message (the CLI's), in MeshLab's log, with the runner's failure exit (255, 1) and no output
+written. hedge-mlx also refuses, with a clear message and its own exit code, an unknown filter or
+parameter, a value of the wrong type, a script that is not one, an input it cannot load and an
+output it cannot save."""
 import os
 import subprocess
 
@@ -55,11 +58,11 @@ def main():
                 name = f"{os.path.basename(source).split('.')[0]}_{op['id']}"
                 out = ml.path(name + ".ply")
                 code, output, _ = ml.apply(source, out, [mt.hedge_filter(ml, op["id"])], name)
-                crashed = code not in (0, 255)
+                crashed = code not in (0, ml.filter_failed)
                 checks.check(not crashed, f"{name}: no crash (exit {code} {CRASHES.get(code, '')})")
                 if code == 0:
                     checks.check(mesh_files.nonempty(out), f"{name}: result saved")
-                elif code == 255:
+                elif code == ml.filter_failed:
                     checks.check(f"{op['filter']} failed: " in output and not os.path.exists(out),
                                  f"{name}: refused with a message in the log, nothing saved")
                 if crashed:
@@ -82,7 +85,8 @@ def main():
                 else:
                     filters = [mt.hedge_filter(ml, op["id"], **{p["id"]: value})]
                 code, output, _ = ml.apply(bunny, out, filters, name)
-                checks.check(code == 255 and not os.path.exists(out), f"{name}={value}: refused, exit 255, nothing saved")
+                checks.check(code == ml.filter_failed and not os.path.exists(out),
+                             f"{name}={value}: refused, exit {code}, nothing saved")
                 if p["type"] != "enum":
                     flag = "--" + p["id"].replace("_", "-")
                     cli = subprocess.run([args.hedge, op["id"], bunny, ml.path("cli.ply"), flag, mt_text(value)],
@@ -92,9 +96,49 @@ def main():
                                  f"{name}: the log says what the CLI says: {message!r}")
                 else:
                     checks.check(f"parameter {p['id']} must be one of" in output, f"{name}: the log names the choices")
+        if ml.runner == "hedge-mlx":
+            runner_refusals(ml, checks, bunny)
     finally:
         ml.close()
     checks.finish()
+
+
+USAGE, IO = 2, 3  # hedge-mlx's exit codes
+
+
+def runner_refusals(ml, checks, bunny):
+    """What hedge-mlx refuses before or around the filters, each with a message naming the cause."""
+    decimate = ml.operations["decimate"]
+    cases = [
+        ("unknown_filter", bunny, [("Hedge: Decimater", [])], USAGE, "no filter named 'Hedge: Decimater' is loaded"),
+        ("unknown_parameter", bunny, [(decimate["filter"], [{"name": "target_ration", "type": "RichFloat",
+                                                             "value": "0.1", "description": "", "tooltip": ""}])],
+         USAGE, "has no parameter 'target_ration'"),
+        ("wrong_type", bunny, [(decimate["filter"], [{"name": "target_faces", "type": "RichFloat", "value": "100",
+                                                      "description": "", "tooltip": ""}])],
+         USAGE, "parameter 'target_faces' holds a"),
+        ("missing_input", ml.path("no_such_mesh.ply"), [mt.hedge_filter(ml, "report")], IO, "cannot load"),
+    ]
+    garbage = ml.path("garbage.ply")
+    with open(garbage, "wb") as f:
+        f.write(b"ply\nformat binary_little_endian 1.0\nelement vertex 99999999\nend_header\n\x01\x02")
+    cases.append(("garbage_input", garbage, [mt.hedge_filter(ml, "report")], IO, "cannot load " + garbage))
+    for name, mesh_in, filters, expected, phrase in cases:
+        out = ml.path(name + ".ply")
+        code, output, _ = ml.apply(mesh_in, out, filters, name)
+        checks.check(code == expected and phrase in output and not os.path.exists(out),
+                     f"{name}: exit {expected} with '{phrase}' (exit {code}: {output.strip().splitlines()[-1:]})")
+    # Saving where it cannot: an unknown format, a folder that does not exist.
+    for name, out, phrase in (("save_unknown_format", ml.path("out.nosuchformat"), "cannot save"),
+                              ("save_no_folder", ml.path("no/such/folder/out.ply"), "cannot save")):
+        code, output, _ = ml.apply(bunny, out, [mt.hedge_filter(ml, "report")], name)
+        checks.check(code == IO and phrase in output and not os.path.exists(out),
+                     f"{name}: exit {IO} with '{phrase}' (exit {code}: {output.strip().splitlines()[-1:]})")
+    script = ml.path("not_a_script.mlx")
+    with open(script, "w") as f:
+        f.write("this is not XML\n")
+    code, output, _ = ml.run_server([bunny, "-", script])
+    checks.check(code == USAGE and "is not a MeshLab filter script" in output, f"not_a_script: exit {USAGE} ({code})")
 
 
 def mt_text(value):

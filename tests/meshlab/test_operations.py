@@ -1,6 +1,8 @@
 """Every catalogue operation as a Hedge filter in a meshlabserver .mlx script, on real meshes,
 with the result read back from the saved file (hedge info/report) and from MeshLab's log; and a
 script chaining three Hedge filters with MeshLab's own filters."""
+import filecmp
+
 import mesh_files
 import meshlab_test as mt
 
@@ -8,11 +10,38 @@ import meshlab_test as mt
 def run(ml, checks, name, mesh_in, filters, save_flags=None):
     out = ml.path(name + ".ply")
     code, output, seconds = ml.apply(mesh_in, out, filters, name, save_flags)
-    ok = checks.check(code == 0, f"{name}: meshlabserver exits 0 (got {code}, {seconds:.1f} s)")
+    ok = checks.check(code == 0, f"{name}: {ml.runner} exits 0 (got {code}, {seconds:.1f} s)")
     ok = checks.check(mesh_files.nonempty(out), f"{name}: wrote {out}") and ok
     if not ok:
         print(output[-2000:])
+    elif ml.runner == "hedge-mlx":
+        check_returned(ml, checks, name, output, filters)
     return out if ok else None, output
+
+
+def same_value(text, value):
+    if isinstance(value, bool):
+        return text == str(value).lower()
+    if isinstance(value, (int, float)):
+        try:
+            return abs(float(text) - value) <= 1e-12 * max(1.0, abs(value))
+        except ValueError:
+            return False
+    return text == str(value)
+
+
+def check_returned(ml, checks, name, output, filters):
+    """2021.05+: what each Hedge filter's applyFilter returned (pymeshlab's return value, printed by
+    hedge-mlx) is its report, entry for entry what it logged."""
+    for filter_name in dict.fromkeys(f for f, _ in filters if f.startswith("Hedge: ")):
+        returned = mt.result_of(output, filter_name)
+        logged = mt.logged(output, filter_name)
+        if not checks.check(returned is not None and "seconds" in returned,
+                            f"{name}: {filter_name} returns its report ({sorted(returned or {})[:4]}...)"):
+            continue
+        differing = {k: (v, returned.get(k)) for k, v in logged.items() if not same_value(v, returned.get(k))}
+        checks.check(not differing and set(logged) <= set(returned),
+                     f"{name}: {filter_name}'s returned map is its logged report ({len(logged)} entries) {differing or ''}")
 
 
 def close(a, b, tolerance):
@@ -180,6 +209,19 @@ def test_chain(ml, checks, bunny):
     checks.check("Hedge: Smooth: seconds = " in output, "chain: the last Hedge filter ran")
 
 
+def test_defaults(ml, checks, bunny):
+    """2021.05+: parameters a script leaves out take the filter's defaults."""
+    out, _ = run(ml, checks, "defaults_decimate", bunny, [mt.hedge_filter_given(ml, "decimate", target_ratio=0.1)])
+    if out:
+        faces = ml.info(out)["faces"]
+        checks.check(abs(faces - 367) <= 1, f"defaults: Decimate given only target_ratio=0.1 gives {faces} faces")
+    full, _ = run(ml, checks, "defaults_smooth_full", bunny, [mt.hedge_filter(ml, "smooth")])
+    bare, _ = run(ml, checks, "defaults_smooth_bare", bunny, [mt.hedge_filter_given(ml, "smooth")])
+    if full and bare:
+        checks.check(filecmp.cmp(full, bare, shallow=False),
+                     "defaults: Smooth with no parameter saves the same file as with every default written out")
+
+
 def main():
     args = mt.parse_args()
     checks = mt.Checks()
@@ -205,6 +247,9 @@ def main():
         print("== polygons")
         if "subdivide" in ml.operations:
             test_polygons(ml, checks)
+        if ml.runner == "hedge-mlx":
+            print("== defaults")
+            test_defaults(ml, checks, bunny)
         print("== chain")
         if all(op in ml.operations for op in ("remesh", "fill_holes", "smooth")):
             test_chain(ml, checks, bunny)

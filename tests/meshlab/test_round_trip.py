@@ -1,7 +1,9 @@
 """A no-op Hedge filter leaves a mesh with UVs, vertex colours, face colours and qualities bit
 for bit: the file MeshLab saves after `Hedge: Mesh Report` or `Hedge: Repair` (which rebuilds
 the mesh through the Soup) is byte-identical to the one it saves with no filter at all.
-Operations that change the mesh keep every attribute channel."""
+Operations that change the mesh keep every attribute channel. With hedge-mlx (2021.05+), a
+filter that fails (a refused value) leaves the document as it was: run with --keep-going, the
+saved file is byte-identical to the reference."""
 import filecmp
 
 import mesh_files
@@ -24,7 +26,7 @@ def main():
             else:  # the full Stanford dragon as it is (clean: Repair has nothing to do)
                 attributed = ml.mesh(source)
             reference = ml.path(stem + "_reference.ply")
-            code, output, _ = ml.run_server(["-i", attributed, "-o", reference, "-m"] + SAVE)
+            code, output, _ = ml.convert(attributed, reference, SAVE)
             if not checks.check(code == 0 and mesh_files.nonempty(reference), f"{stem}: MeshLab saves it unchanged"):
                 print(output[-2000:])
                 continue
@@ -43,6 +45,15 @@ def main():
                 checks.check(code == 0 and mesh_files.nonempty(out), f"{stem}: Hedge {op_id} runs ({code})")
                 same = mesh_files.nonempty(out) and filecmp.cmp(reference, out, shallow=False)
                 checks.check(same, f"{stem}: after Hedge {op_id} the saved file is byte-identical to the reference")
+            if ml.runner == "hedge-mlx":
+                # A refused value: MLException thrown, the document untouched, the rest of the script runs.
+                out = ml.path(f"{stem}_failed.ply")
+                failing = [mt.hedge_filter(ml, "decimate", target_ratio=1.5), mt.hedge_filter(ml, "report")]
+                code, output, _ = ml.apply(attributed, out, failing, f"{stem}_failed", SAVE, extra=["--keep-going"])
+                checks.check(code == ml.filter_failed and "Hedge: Decimate failed: " in output,
+                             f"{stem}: a refused Decimate fails (exit {code})")
+                same = mesh_files.nonempty(out) and filecmp.cmp(reference, out, shallow=False)
+                checks.check(same, f"{stem}: after the failed Decimate the saved file is byte-identical to the reference")
 
         # Changing operations carry every channel (colours, qualities, UVs) through.
         attributed = ml.path("bunny_attributes.ply")
