@@ -361,9 +361,12 @@ def _write_attributes(me, data, result, create, loop_inverse=None):
             ("hidden", "face", me.polygons, "hide", np.bool_),
             ("bevel_weight", "vertex", me.vertices, "bevel_weight", np.float32)):
         values = channel(soup, name, domain)
-        if values is None or (create and not values.any()):
-            continue  # new geometry starts with zeros and False: nothing to write
-        _set(collection, prop, values.view(dtype) if dtype == np.bool_ else values.astype(dtype, copy=False))
+        if values is None:
+            continue
+        values = values.view(dtype) if dtype == np.bool_ else values.astype(dtype, copy=False)
+        if create and np.array_equal(_get(collection, prop, len(collection), dtype), values):
+            continue  # what new geometry holds already (zeros, False; smooth faces from 4.1 on)
+        _set(collection, prop, values)
 
 
 def _write_edges(me, data, result):

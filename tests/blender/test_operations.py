@@ -9,8 +9,8 @@ import bmesh  # noqa: E402
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 import unittest  # noqa: E402
-from blender_test import (ARGS, add_primitive, boundary_loops, clear_scene, counts, edge_lengths,  # noqa: E402
-                          import_mesh, install_addon, mesh_arrays, run_tests, select_only)
+from blender_test import (ARGS, FREESTYLE_MARKS, LAYERS, add_primitive, boundary_loops, clear_scene, counts,  # noqa: E402
+                          edge_lengths, import_mesh, install_addon, mesh_arrays, run_tests, select_only, set_layer)
 
 hedge = install_addon()
 
@@ -185,6 +185,28 @@ class PrimitivesTest(unittest.TestCase):
         self.assertTrue(np.all(mesh_arrays(obj.data)["loop_total"] == 3))
         self.assertAlmostEqual(float(np.mean(lengths)), 0.1, delta=0.02)
         self.assertLess(float(np.std(lengths) / np.mean(lengths)), 0.3)
+
+    def test_edge_data_follows_a_rebuild(self):
+        # Triangulating the cube rebuilds the mesh: its 12 edges keep seams, sharpness, freestyle
+        # marks, creases and bevel weights (properties in 3.x, attributes from 4.0), the 6 new
+        # diagonals have none, and every datum exists once (no sharp_edge.001).
+        me = add_primitive("cube").data
+        for prop in ("use_seam", "use_edge_sharp") + (("use_freestyle_mark",) if FREESTYLE_MARKS else ()):
+            me.edges.foreach_set(prop, np.ones(12, bool))
+        for key, (collection, _, _, _) in LAYERS.items():
+            set_layer(me, key, np.full(len(getattr(me, collection)), 0.5, np.float32))
+        names = sorted(a.name for a in me.attributes if not a.name.startswith("."))
+        self.assertEqual(bpy.ops.mesh.hedge_triangulate(), {'FINISHED'})
+        self.assertEqual(len(me.edges), 18)
+        arr = mesh_arrays(me)
+        self.assertEqual(sorted(a.name for a in me.attributes if not a.name.startswith(".")), names)
+        self.assertFalse(arr["smooth"].any(), "the flat cube came back smooth")
+        per_edge = [k for k in arr if k.startswith("edge:") or k.endswith(":EDGE")]
+        self.assertGreaterEqual(len(per_edge), 4 + FREESTYLE_MARKS, per_edge)
+        for key in per_edge:
+            self.assertEqual(np.count_nonzero(arr[key]), 12, key)
+        self.assertTrue(np.all(arr["vertex:bevel_weight" if "vertex:bevel_weight" in arr
+                                   else "attr:bevel_weight_vert:POINT"] == 0.5))
 
     def test_smooth_in_place_keeps_everything(self):
         obj = add_primitive("monkey")
