@@ -1,16 +1,21 @@
 # The demo's Blender part, run by scripts/demo in `blender -b`: the main job on the Stanford
 # dragon through the add-on's batch API (decimate to 10 %, remesh, fill holes), timed, next to
-# Blender's own Decimate modifier; then a before/after picture rendered with Workbench.
+# Blender's own Decimate modifier; then a before/after picture rendered with Workbench. The
+# same script in every Blender from 3.4 on (5.2 in the sid root).
 #   blender -b --factory-startup --python-exit-code 1 --python demo_job.py -- \
-#       --mesh dragon.ply --out DIR [--picture docs/blender_demo.png] [--no-modifier] [--render-only]
+#       --mesh dragon.ply --out DIR [--zip PACKAGE] [--picture docs/blender_demo.png] [--no-modifier] [--no-render]
+# --zip: installed first when hedge is not installed yet: the legacy add-on zip for Blender
+# 3.4-4.1, the extension zip (build/hedge_blender_extension.zip) for 4.2 and later.
 import argparse
 import json
 import os
 import sys
 import time
 
-import addon_utils
 import bpy
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tools"))
+import hedge_install  # noqa: E402
 
 argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
 parser = argparse.ArgumentParser()
@@ -19,17 +24,16 @@ parser.add_argument("--out", required=True)
 parser.add_argument("--picture", default="", help="also write a small copy of the picture here")
 parser.add_argument("--no-modifier", action="store_true", help="skip Blender's Decimate modifier")
 parser.add_argument("--no-render", action="store_true")
-parser.add_argument("--zip", default="", help="install this add-on zip first if hedge is not installed")
+parser.add_argument("--zip", default="", help="install this package first if hedge is not installed")
 args = parser.parse_args(argv)
 os.makedirs(args.out, exist_ok=True)
 
-if addon_utils.enable("hedge", default_set=True, handle_error=lambda e: None) is None:
+try:
+    hedge_install.enable(quiet=True)
+except RuntimeError:
     if not args.zip:
-        sys.exit("the hedge add-on is not installed (./run install)")
-    bpy.ops.preferences.addon_install(filepath=os.path.abspath(args.zip), overwrite=True)
-    addon_utils.modules_refresh()
-    if addon_utils.enable("hedge", default_set=True, handle_error=None) is None:
-        sys.exit("the hedge add-on did not enable")
+        sys.exit("the hedge add-on is not installed (./run install, or pass --zip)")
+    hedge_install.install(args.zip)
 import hedge  # noqa: E402
 
 for obj in list(bpy.data.objects):
@@ -141,6 +145,7 @@ scene.render.resolution_percentage = 100
 scene.render.film_transparent = False
 scene.world = bpy.data.worlds.new("world") if scene.world is None else scene.world
 scene.world.color = (1, 1, 1)
+scene.view_settings.view_transform = 'Standard'  # a white background (4.x's default AgX greys it)
 scene.render.image_settings.file_format = 'PNG'
 scene.render.filepath = os.path.join(args.out, "blender_before_after.png")
 _, t = timed("render", lambda: bpy.ops.render.render(write_still=True))

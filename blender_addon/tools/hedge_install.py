@@ -6,6 +6,7 @@
 #                    install-file -r user_default -e ZIP`, run as a separate Blender
 # Files land under the user's folder ($HOME/.config/blender/<version>/...): give tests a
 # private HOME.
+import importlib
 import os
 import subprocess
 
@@ -40,12 +41,14 @@ def install(zip_path):
     else:
         bpy.ops.preferences.addon_install(filepath=zip_path, overwrite=True)
         addon_utils.modules_refresh()
+    importlib.invalidate_caches()  # a folder listed before the install (a first look) is listed anew
     return enable()
 
 
-def enable():
-    """Enables the installed add-on; returns the package (raises when it does not enable)."""
-    module = addon_utils.enable(MODULE, default_set=True, handle_error=None)
+def enable(quiet=False):
+    """Enables the installed add-on; returns the package (raises when it does not enable;
+    `quiet`: without Blender printing why, for a first look whether it is installed)."""
+    module = addon_utils.enable(MODULE, default_set=True, handle_error=(lambda e: None) if quiet else None)
     if module is None:
         raise RuntimeError(f"the hedge add-on ({MODULE}) did not enable")
     return module
