@@ -190,6 +190,11 @@ def edge_lengths(me):
     return np.linalg.norm(co[edges[:, 0]] - co[edges[:, 1]], axis=1)
 
 
+# The exit code of a run where nothing failed but a case was skipped (e.g. the meshes were not
+# fetched): ctest reports the test as skipped (SKIP_RETURN_CODE), not as passed.
+SKIPPED = 77
+
+
 def run_tests(*cases):
     suite = unittest.TestSuite()
     for case in cases:
@@ -198,3 +203,14 @@ def run_tests(*cases):
     sys.stdout.flush()
     if not result.wasSuccessful():
         raise SystemExit(1)
+    if result.skipped:
+        print(f"{len(result.skipped)} of {result.testsRun} cases skipped: the test counts as skipped", flush=True)
+        raise SystemExit(SKIPPED)
+
+
+def mesh_path(test, name):
+    """The path of a fetched real mesh, or the case is skipped (and so the whole test)."""
+    path = os.path.join(ARGS.meshes, name)
+    if not ARGS.meshes or not os.path.exists(path):
+        test.skipTest(f"{name} is not in --meshes {ARGS.meshes!r} (./run fetch)")
+    return path

@@ -9,8 +9,9 @@ import bmesh  # noqa: E402
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 import unittest  # noqa: E402
-from blender_test import (ARGS, FREESTYLE_MARKS, LAYERS, add_primitive, boundary_loops, clear_scene, counts,  # noqa: E402
-                          edge_lengths, import_mesh, install_addon, mesh_arrays, run_tests, select_only, set_layer)
+from blender_test import (FREESTYLE_MARKS, LAYERS, add_primitive, boundary_loops, clear_scene, counts,  # noqa: E402
+                          edge_lengths, import_mesh, install_addon, mesh_arrays, mesh_path, run_tests, select_only,
+                          set_layer)
 
 hedge = install_addon()
 
@@ -331,14 +332,9 @@ class PrimitivesTest(unittest.TestCase):
 class RealMeshesTest(unittest.TestCase):
     def setUp(self):
         clear_scene()
-        if not ARGS.meshes or not os.path.isdir(ARGS.meshes):
-            self.skipTest("no meshes folder")
 
     def path(self, name):
-        p = os.path.join(ARGS.meshes, name)
-        if not os.path.exists(p):
-            self.skipTest(f"{p} missing")
-        return p
+        return mesh_path(self, name)
 
     def test_dragon_res2_every_operator(self):
         for op in hedge.catalogue():

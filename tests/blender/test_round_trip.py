@@ -11,8 +11,8 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 import unittest  # noqa: E402
-from blender_test import (ARGS, FREESTYLE_MARKS, LAYERS, add_primitive, clear_scene, install_addon,  # noqa: E402
-                          is_edge_key, mesh_arrays, run_tests, set_layer)
+from blender_test import (FREESTYLE_MARKS, LAYERS, add_primitive, clear_scene, install_addon,  # noqa: E402
+                          is_edge_key, mesh_arrays, mesh_path, run_tests, set_layer)
 
 hedge = install_addon()
 from hedge import exchange  # noqa: E402
@@ -138,9 +138,7 @@ class RoundTripTest(unittest.TestCase):
         self.assertEqual(obj.vertex_groups["g"].weight(2), 0.5)
 
     def test_full_dragon_exchange_time(self):
-        path = os.path.join(ARGS.meshes, "dragon.ply")
-        if not os.path.exists(path):
-            self.skipTest("no dragon.ply")
+        path = mesh_path(self, "dragon.ply")
         start = time.perf_counter()
         obj = hedge.api.import_file(path)
         t_import = time.perf_counter() - start
