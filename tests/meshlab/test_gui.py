@@ -1,4 +1,6 @@
-"""GUI smoke test under Xvfb: MeshLab starts with the plugin, and its Filters menu holds every
+"""GUI test under Xvfb: MeshLab starts with the plugin (2020.09: the PREFIX copy; 2021.05+: the
+system meshlab of the root, the plugin installed for the user by scripts/install_meshlab --user),
+and its Filters menu holds every
 Hedge filter under the submenu of its class; Hedge: Decimate opens its parameter dialog and
 applies from it; a refused value brings up MeshLab's failure box with hedge's message. The menus are found and read by OCR (tesseract) on screenshots, so no screen
 coordinate is hard-coded; the screenshots stay in the test's output folder."""
@@ -141,9 +143,10 @@ def wait_for(predicate, seconds):
     return False
 
 
-def check_failure_box(screen, checks, dialog, read_log, faces):
+def check_failure_box(screen, checks, dialog, read_log, faces, docked):
     """A value the catalogue refuses, typed into the still open Decimate dialog: MeshLab's
-    "Filter Failure" box shows hedge's message, and the mesh keeps its faces."""
+    "Filter Failure" box shows hedge's message, and the mesh keeps its faces. `docked`: the dialog
+    sits over the 3D view's counts (2021.05+)."""
     label = screen.find(dialog, "Target faces", DIALOG)
     apply = screen.find(dialog, "Apply", DIALOG)
     if not checks.check(label is not None and apply is not None, "the dialog's Target faces field is found"):
@@ -161,28 +164,57 @@ def check_failure_box(screen, checks, dialog, read_log, faces):
     checks.check(wait_for(lambda: "Hedge: Decimate failed: decimate: parameter target_faces" in read_log(), 10),
                  "the failure is in MeshLab's log")
     screen.xdotool("key", "Return")
+    if docked:
+        # The dialog covers the counts: close it to read them (the decimated count, kept by the failure).
+        shot, _ = screen.wait_for_text("dialog_after_failure", DIALOG, ["Close"])
+        close = screen.find(shot, "Close", DIALOG)
+        if checks.check(close is not None, "the dialog has Close"):
+            screen.click(close)
     _, text = screen.wait_for_text("after_failure", OVERLAY, [f"Faces: {faces:,}"])
-    checks.check(normal(f"Faces: {faces:,}") in text, f"the failed filter left the mesh as it was ({faces:,} faces)")
+    checks.check(normal(f"Faces: {faces:,}") in text,
+                 f"MeshLab shows {faces:,} faces: the decimated mesh, which the failed filter left as it was")
+
+
+def dismiss_plugin_errors(screen, checks):
+    """2021.05+ stop before the main window with a modal box when a system plugin does not load (a
+    library missing in the root, e.g. trixie's mesh_booleans without libmpfr6, which meshlab only
+    recommends). Hedge's plugin must not be among them; the box is dismissed and noted. MeshLab
+    2022.02 then loads no plugin of the user's folder either (the failure ends its loading before
+    it), so the Hedge filters are missing and the checks below fail: the root must hold every
+    library meshlab recommends. True if there was a box."""
+    shot, text = screen.wait_for_text("plugin_errors", None, ["Unable to load the following plugins"], 20)
+    if not contains(text, "Unable to load the following plugins"):
+        return False
+    checks.check("filterhedge" not in text, "Hedge's plugin is not among the plugins MeshLab could not load")
+    print(f"  note  MeshLab could not load some system plugins ({os.path.basename(shot)}): dismissed; 2022.02 "
+          "then skips the user's plugin folder (install the libraries meshlab recommends in the root)")
+    screen.xdotool("key", "Return")
+    return True
 
 
 def main():
     args = mt.parse_args()
     checks = mt.Checks()
-    ml = mt.MeshLab(args)
+    ml = mt.MeshLab(args, need_x=True)
     log_path = ml.path("meshlab.log")
     gui = None
     try:
-        if not checks.check(os.access(ml.gui, os.X_OK), "the PREFIX copy of meshlab exists"):
+        if not checks.check(os.access(ml.gui, os.X_OK), f"{ml.gui} exists"):
             checks.finish()
+        if ml.runner == "hedge-mlx":
+            done = ml.install_for_user()
+            checks.check(done.returncode == 0, f"the plugin is installed for the user: {done.stderr.strip()}")
         log = open(log_path, "w")
         gui = subprocess.Popen([ml.gui, ml.mesh("bunny.off")], env=ml.env(), stdout=log, stderr=subprocess.STDOUT,
                                cwd=ml.out)
         read_log = lambda: open(log_path, errors="replace").read()
-        started = wait_for(lambda: "All files opened" in read_log(), 60)
-        checks.check(started, "MeshLab starts and opens the bunny")
-        checks.check(os.path.join("meshlab-prefix", "lib") in read_log() or "plugins" in read_log(),
-                     "MeshLab loads plugins from the PREFIX")
         screen = Screen(ml)
+        started = wait_for(lambda: "All files opened" in read_log(), 10) or \
+            dismiss_plugin_errors(screen, checks) and wait_for(lambda: "All files opened" in read_log(), 50)
+        checks.check(started, "MeshLab starts and opens the bunny")
+        if ml.runner == "meshlabserver":
+            checks.check(os.path.join("meshlab-prefix", "lib") in read_log() or "plugins" in read_log(),
+                         "MeshLab loads plugins from the PREFIX")
         main_shot, _ = screen.wait_for_text("main_window", MENU_BAR, ["Filters"])
         filters = screen.find(main_shot, "Filters", MENU_BAR, scale=3)
         if not checks.check(filters is not None, "the menu bar has Filters (OCR)"):
@@ -223,9 +255,15 @@ def main():
                     applied = wait_for(faces_after, 60)
                     faces = int(faces_after().group(1)) if applied else 0
                     checks.check(applied and abs(faces - 3674 // 2) <= 1, f"Apply decimates the bunny to half ({faces}, MeshLab's log)")
-                    _, text = screen.wait_for_text("after_decimate", OVERLAY, [f"Faces: {faces:,}"])
-                    checks.check(normal(f"Faces: {faces:,}") in text, f"MeshLab shows {faces:,} faces")
-                    check_failure_box(screen, checks, dialog, read_log, faces)
+                    # 2021.05+ dock the dialog over the 3D view's counts: read after closing it.
+                    docked = ml.runner == "hedge-mlx"
+                    if docked:
+                        checks.check(contains(dialog_text, "hedge_decimate"),
+                                     "the dialog gives the PyMeshLab name hedge_decimate")
+                    else:
+                        _, text = screen.wait_for_text("after_decimate", OVERLAY, [f"Faces: {faces:,}"])
+                        checks.check(normal(f"Faces: {faces:,}") in text, f"MeshLab shows {faces:,} faces")
+                    check_failure_box(screen, checks, dialog, read_log, faces, docked)
         checks.check(gui.poll() is None, "MeshLab is still running")
     except (mt.Failure, subprocess.CalledProcessError) as e:
         checks.check(False, str(e))
