@@ -1,12 +1,11 @@
 #!/usr/bin/env python3
-"""Writes a meshlabserver .mlx script of Hedge filters from the catalogue, every parameter
-listed with its Rich type as MeshLab 2020.09 requires (defaults unless given).
+"""Writes a MeshLab .mlx script of Hedge filters from the catalogue, every parameter listed with
+its Rich type as meshlabserver 2020.09 requires (defaults unless given); hedge-mlx (2021.05+)
+runs the same scripts.
 
   make_mlx.py --catalogue build/bin/hedge_meshlab_catalogue OUT.mlx "decimate target_ratio=0.1" "fill_holes"
 """
 import argparse
-import json
-import subprocess
 import sys
 
 import meshlab_test as mt
@@ -14,7 +13,7 @@ import meshlab_test as mt
 
 class Catalogue:
     def __init__(self, tool):
-        data = json.loads(subprocess.run([tool], check=True, capture_output=True, text=True).stdout)
+        data = mt.read_catalogue(tool)
         self.operations = {op["id"]: op for op in data["operations"]}
 
 
@@ -32,7 +31,7 @@ def parse_value(p, text):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--catalogue", required=True, help="the hedge_meshlab_catalogue program")
+    parser.add_argument("--catalogue", required=True, help="the hedge_meshlab_catalogue program, or its JSON")
     parser.add_argument("out", help="the .mlx file to write ('-' for stdout)")
     parser.add_argument("steps", nargs="+", help="an operation id and its id=value pairs, one argument per filter")
     args = parser.parse_args()
