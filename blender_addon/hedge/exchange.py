@@ -10,7 +10,7 @@
 #   material indices             face "material"            i32
 #   smooth shading               face "smooth"              u8
 #   selection, hiding            "selected", "hidden"       u8, vertex and face
-#   vertex bevel weight (3.x)    vertex "bevel_weight"      f32
+#   vertex bevel weight          vertex "bevel_weight"      f32 (3.x; from 4.0 attr:bevel_weight_vert)
 #   vertex identity              vertex "blender:vertex"    i32 (where each result vertex came from)
 #   each vertex group            vertex "vgroup:<name>"     f32 weight (0 where not a member)
 # Edge data (seams, sharp edges, creases, bevel weights, generic edge attributes) has no
@@ -25,22 +25,22 @@ import bpy
 import numpy as np
 
 # Blender attribute type -> (foreach property, numpy dtype, components)
-# (the types a Blender does not have never occur in it: INT32_2D, QUATERNION and FLOAT4X4 came in
-# 3.6 and 4.0, INT16_2D and FLOAT4 in 4.4+)
+# (a type the running Blender lacks never occurs: 3.4 has the first eight types below, 4.3 adds
+# INT32_2D, QUATERNION and FLOAT4X4, 5.2 also INT16_2D and FLOAT4)
 ATTRIBUTE_TYPES = {
     'FLOAT': ("value", np.float32, 1),
     'INT': ("value", np.int32, 1),
     'FLOAT_VECTOR': ("vector", np.float32, 3),
     'FLOAT2': ("vector", np.float32, 2),
-    'FLOAT4': ("vector", np.float32, 4),
     'FLOAT_COLOR': ("color", np.float32, 4),
     'BYTE_COLOR': ("color_srgb", np.float32, 4),
     'BOOLEAN': ("value", np.bool_, 1),
     'INT8': ("value", np.int8, 1),
-    'INT16_2D': ("value", np.int16, 2),
     'INT32_2D': ("value", np.int32, 2),
     'QUATERNION': ("value", np.float32, 4),
     'FLOAT4X4': ("value", np.float32, 16),
+    'INT16_2D': ("value", np.int16, 2),
+    'FLOAT4': ("vector", np.float32, 4),
 }
 DOMAINS = {'POINT': "vertex", 'FACE': "face", 'CORNER': "corner"}
 BLENDER_DOMAINS = {v: k for k, v in DOMAINS.items()}
