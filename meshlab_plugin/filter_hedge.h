@@ -1,6 +1,7 @@
 // The MeshLab 2020.09 glue: one MeshFilterInterface filter per catalogue operation. All that
-// is specific to this plugin API lives here and in filter_hedge.cpp; a 2022+ FilterPlugin port
-// replaces these two files only (see README.md, "MeshLab").
+// is specific to this plugin API lives here and in filter_hedge.cpp; the 2021.05+ FilterPlugin
+// glue (2022.02, 2025.07) is filter_plugin_hedge.{h,cpp}, and both share hedge_filters and
+// cmesh_soup.
 #pragma once
 
 #include <common/interfaces.h>
