@@ -1,9 +1,22 @@
 // The plugin inside MeshLab's own library, in process: libfilter_hedge.so and MeshLab's io_base
-// plugin loaded with QPluginLoader into a real MeshDocument, to check what meshlabserver cannot
-// show: a failed or cancelled filter leaves the mesh exactly as it was, progress stages arrive,
-// deleted elements are skipped, selection and custom attributes survive, polygons come back as
-// faux-edge fans.
+// plugin loaded into a real MeshDocument, to check what a batch run cannot show: a failed or
+// cancelled filter leaves the mesh exactly as it was, progress stages arrive, deleted elements
+// are skipped, selection and custom attributes survive, polygons come back as faux-edge fans.
+// Built for every MeshLab version: 2020.09 (MeshFilterInterface, plugins loaded with
+// QPluginLoader) and 2021.05+ (FilterPlugin, loaded by MeshLab's own plugin manager, with its
+// checks; run inside the version's root). The few API differences are in the block below.
+// MeshLab's headers first: vcg's own headers need what they include before them.
+#include "meshlab_api.h"
+#if HEDGE_MESHLAB_FILTER_PLUGIN
+#include <common/globals.h>
+#include <common/mlexception.h>
+#include <common/plugins/interfaces/filter_plugin.h>
+#include <common/plugins/plugin_manager.h>
+#include <common/utilities/load_save.h>
+#else
 #include <common/interfaces.h>
+#endif
+
 #include <gtest/gtest.h>
 #include <vcg/complex/allocate.h>
 
@@ -19,8 +32,48 @@
 
 namespace {
 
+#if HEDGE_MESHLAB_FILTER_PLUGIN
+FilterPlugin* hedge_plugin = nullptr;
+// 2021.05+ hold an enum's index and a slider's value as plain int and float values.
+using DynamicFloatValue = FloatValue;
+using EnumValue = IntValue;
+#else
 MeshFilterInterface* hedge_plugin = nullptr;
 MeshIOInterface* io_plugin = nullptr;
+#endif
+// The message of the last failed filter (2020.09: errorMsg(); 2021.05+: the MLException thrown).
+std::string last_error;
+// What the last filter returned (2021.05+: its report; 2020.09: nothing).
+std::map<std::string, QVariant> last_result;
+
+RichParameterList default_parameters(QAction* action, MeshDocument& document) {
+  RichParameterList parameters;
+#if HEDGE_MESHLAB_FILTER_PLUGIN
+  parameters = hedge_plugin->initParameterList(action, document);
+#else
+  hedge_plugin->initParameterSet(action, document, parameters);
+#endif
+  return parameters;
+}
+
+bool apply_filter(QAction* action, MeshDocument& document, const RichParameterList& parameters, vcg::CallBackPos* cb) {
+  last_error.clear();
+  last_result.clear();
+#if HEDGE_MESHLAB_FILTER_PLUGIN
+  try {
+    unsigned int post_condition = 0;
+    last_result = hedge_plugin->applyFilter(action, parameters, document, post_condition, cb);
+    return true;
+  } catch (const MLException& e) {
+    last_error = e.what();
+    return false;
+  }
+#else
+  const bool applied = hedge_plugin->applyFilter(action, document, parameters, cb);
+  if (!applied) last_error = hedge_plugin->errorMsg().toStdString();
+  return applied;
+#endif
+}
 
 // Everything a filter could touch, as plain values, so "untouched" is one comparison.
 struct Snapshot {
@@ -84,6 +137,9 @@ struct Document {
   GLLogStream log;
 
   explicit Document(const std::string& path) {
+#if HEDGE_MESHLAB_FILTER_PLUGIN
+    model = meshlab::loadMeshWithStandardParameters(QString::fromStdString(path), document).front();
+#else
     model = document.addNewMesh(QString::fromStdString(path), "mesh", true);
     const QString format = QFileInfo(QString::fromStdString(path)).suffix().toLower();
     RichParameterList pre;
@@ -95,17 +151,14 @@ struct Document {
     vcg::tri::UpdateNormal<CMeshO>::PerFaceNormalized(model->cm);
     if (!(mask & vcg::tri::io::Mask::IOM_VERTNORMAL)) vcg::tri::UpdateNormal<CMeshO>::PerVertexAngleWeighted(model->cm);
     vcg::tri::UpdateBounding<CMeshO>::Box(model->cm);
+#endif
     hedge_plugin->setLog(&log);
   }
 
-  RichParameterList defaults(QAction* action) {
-    RichParameterList parameters;
-    hedge_plugin->initParameterSet(action, document, parameters);
-    return parameters;
-  }
+  RichParameterList defaults(QAction* action) { return default_parameters(action, document); }
 
-  bool apply(const std::string& op_id, RichParameterList parameters, vcg::CallBackPos* cb = nullptr) {
-    return hedge_plugin->applyFilter(action_of(op_id), document, parameters, cb);
+  bool apply(const std::string& op_id, const RichParameterList& parameters, vcg::CallBackPos* cb = nullptr) {
+    return apply_filter(action_of(op_id), document, parameters, cb);
   }
   bool apply(const std::string& op_id) { return apply(op_id, defaults(action_of(op_id))); }
 
@@ -157,7 +210,7 @@ TEST_F(PluginTest, OutOfRangeParameterIsRefusedAndTheMeshIsUntouched) {
   parameters.setValue("target_ratio", DynamicFloatValue(1.5f));
   EXPECT_FALSE(doc.apply("decimate", parameters));
   const std::string expected = "decimate: parameter target_ratio must be a number from 0 to 1, got '1.5'";
-  EXPECT_EQ(hedge_plugin->errorMsg().toStdString(), expected);
+  EXPECT_EQ(last_error, expected);
   EXPECT_NE(doc.log_text().find("Hedge: Decimate failed: " + expected), std::string::npos) << doc.log_text();
   EXPECT_TRUE(snapshot(*doc.model) == before);
 }
@@ -178,7 +231,7 @@ TEST_F(PluginTest, CancelledMidwayLeavesTheMeshUntouched) {
       continue;
     }
     EXPECT_FALSE(applied) << op.id;
-    EXPECT_EQ(hedge_plugin->errorMsg().toStdString(), "cancelled by the user") << op.id;
+    EXPECT_EQ(last_error, "cancelled by the user") << op.id;
     EXPECT_TRUE(snapshot(*doc.model) == before) << op.id << " changed the mesh although it was cancelled";
     cancelled.push_back(op.id);
   }
@@ -266,7 +319,7 @@ TEST_F(PluginTest, FaceOnADeletedVertexIsRefused) {
   EXPECT_FALSE(doc.apply("smooth"));
   // The first face on that vertex is named (face 7 or one before it around the vertex).
   const std::string expected = " uses vertex " + std::to_string(v - m.vert.data()) + ", which is deleted";
-  const std::string message = hedge_plugin->errorMsg().toStdString();
+  const std::string message = last_error;
   EXPECT_EQ(message.rfind("face ", 0), 0u) << message;
   EXPECT_NE(message.find(expected), std::string::npos) << message;
   EXPECT_NE(doc.log_text().find("Hedge: Smooth failed: " + message), std::string::npos) << doc.log_text();
@@ -341,9 +394,37 @@ TEST_F(PluginTest, NoMeshIsAnErrorNotACrash) {
   GLLogStream log;
   hedge_plugin->setLog(&log);
   RichParameterList parameters;  // the report has no parameters
-  EXPECT_FALSE(hedge_plugin->applyFilter(action_of("report"), empty, parameters, nullptr));
-  EXPECT_NE(hedge_plugin->errorMsg().toStdString().find("no mesh"), std::string::npos);
+  EXPECT_FALSE(apply_filter(action_of("report"), empty, parameters, nullptr));
+  EXPECT_NE(last_error.find("no mesh"), std::string::npos);
 }
+
+#if HEDGE_MESHLAB_FILTER_PLUGIN
+// What pymeshlab hands back to Python: the report, entry for entry as the log has it.
+TEST_F(PluginTest, ApplyFilterReturnsTheReport) {
+  Document doc(mesh_path("bunny.off"));
+  ASSERT_TRUE(doc.apply("report")) << last_error;
+  ASSERT_EQ(last_result.count("faces"), 1u);
+  EXPECT_EQ(last_result["faces"].toLongLong(), 3674);
+  EXPECT_EQ(last_result["genus"].toLongLong(), 0);
+  EXPECT_GT(last_result["area"].toDouble(), 0.0);
+  RichParameterList parameters = doc.defaults(action_of("decimate"));
+  parameters.setValue("target_faces", IntValue(1000));
+  ASSERT_TRUE(doc.apply("decimate", parameters)) << last_error;
+  EXPECT_EQ(last_result["faces_after"].toLongLong(), doc.model->cm.fn);
+  EXPECT_EQ(last_result["stopped_by"].toString().toStdString(), "target reached");
+}
+
+// MeshLab's own loader took the plugin (its version, class, pre/postcondition and arity checks).
+TEST_F(PluginTest, PythonNamesAndClasses) {
+  for (const hedge::Operation& op : hedge::catalogue()) {
+    QAction* action = action_of(op.id);
+    ASSERT_NE(action, nullptr) << op.id;
+    EXPECT_EQ(hedge_plugin->pythonFilterName(action).toStdString(), "hedge_" + op.id);
+    EXPECT_NE(hedge_plugin->getClass(action), FilterPlugin::Generic) << op.id;
+    EXPECT_EQ(hedge_plugin->filterArity(action), FilterPlugin::SINGLE_MESH) << op.id;
+  }
+}
+#endif
 
 }  // namespace
 
@@ -351,6 +432,19 @@ int main(int argc, char** argv) {
   ::testing::InitGoogleTest(&argc, argv);
   setenv("QT_QPA_PLATFORM", "offscreen", 1);
   QApplication app(argc, argv);
+#if HEDGE_MESHLAB_FILTER_PLUGIN
+  try {
+    meshlab::pluginManagerInstance().loadPlugin(MESHLAB_IO_PLUGIN_PATH);
+    hedge_plugin = dynamic_cast<FilterPlugin*>(meshlab::pluginManagerInstance().loadPlugin(HEDGE_PLUGIN_PATH));
+  } catch (const MLException& e) {
+    std::fprintf(stderr, "MeshLab refuses a plugin: %s\n", e.what());
+    return 1;
+  }
+  if (!hedge_plugin) {
+    std::fprintf(stderr, "%s is not a filter plugin\n", HEDGE_PLUGIN_PATH);
+    return 1;
+  }
+#else
   QPluginLoader hedge_loader(HEDGE_PLUGIN_PATH);
   hedge_plugin = qobject_cast<MeshFilterInterface*>(hedge_loader.instance());
   if (!hedge_plugin) {
@@ -363,5 +457,6 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "cannot load %s: %s\n", MESHLAB_IO_PLUGIN_PATH, qUtf8Printable(io_loader.errorString()));
     return 1;
   }
+#endif
   return RUN_ALL_TESTS();
 }
