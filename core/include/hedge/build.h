@@ -1,5 +1,5 @@
 // build(): Soup -> Mesh, accepting everything a host can hold; extract(): Mesh -> Soup.
-// See DESIGN.md "Robust building".
+// The contract is in docs/architecture.md, "One pipeline".
 #pragma once
 
 #include <cstddef>
