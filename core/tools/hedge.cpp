@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <iostream>
 #include <map>
 #include <string>
@@ -17,6 +18,7 @@
 #include "hedge/report.h"
 #include "hedge/threads.h"
 #include "hedge/topology.h"
+#include "terminal_progress.h"
 
 namespace {
 
@@ -31,8 +33,10 @@ constexpr const char* kUsage =
     "                                    and the faces of B turned over against A\n"
     "  hedge list [--json]               every operation with its parameters\n"
     "  hedge help OP                     one operation in full\n"
-    "  hedge OP IN [OUT] [--param value ...] [--json] [--ascii]\n"
-    "                                    run an operation (OUT not needed for report)\n"
+    "  hedge OP IN [OUT] [--param value ...] [--json] [--ascii] [--quiet]\n"
+    "                                    run an operation (OUT not needed for report); on a terminal\n"
+    "                                    its stages and a progress bar go to stderr (-q, --quiet: none);\n"
+    "                                    Ctrl-C cancels, writes no OUT and exits with 130\n"
     "environment: HEDGE_THREADS=N        threads to use (default: all cores; results never depend on it)\n";
 
 std::string flag_of(const std::string& id) {
@@ -210,7 +214,7 @@ int run(const std::string& id, const std::vector<std::string>& args) {
   const Operation& op = find_operation(id);
   std::vector<std::string> files;
   std::map<std::string, std::string> given;
-  bool json = false;
+  bool json = false, quiet = false;
   WriteOptions options;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
@@ -218,6 +222,8 @@ int run(const std::string& id, const std::vector<std::string>& args) {
       json = true;
     else if (a == "--ascii")
       options.binary = false;
+    else if (a == "--quiet" || a == "-q")
+      quiet = true;
     else if (a.rfind("--", 0) == 0) {
       std::string key = a, value;
       if (auto eq = a.find('='); eq != std::string::npos) {
@@ -239,9 +245,34 @@ int run(const std::string& id, const std::vector<std::string>& args) {
                 "'");
   ParamValues params = resolve_params(op, given);  // refuse bad parameters before reading anything
   if (op.changes_mesh) format_from_path(files[1]);
+  cli::TerminalProgress bar(!quiet);
+  const auto stop_if_interrupted = [] {
+    if (cli::interrupted()) throw Cancelled();
+  };
+  const auto file_name = [](const std::string& path) { return std::filesystem::path(path).filename().string(); };
+  bar.update(0, "reading " + file_name(files[0]));
   Soup soup = read_mesh(files[0]);
-  RunResult result = run_operation(op, soup, params, Progress::none());
-  if (op.changes_mesh) write_mesh(result.soup, files[1], options);
+  stop_if_interrupted();  // reading does not look at the flag itself
+  Progress progress([&](double fraction, const std::string& stage) { return bar.update(fraction, stage); });
+  RunResult result = run_operation(op, soup, params, progress);
+  if (op.changes_mesh) {
+    bar.update(1, "writing " + file_name(files[1]));
+    // Written beside OUT under a hidden name with OUT's extension (which picks the format), then
+    // renamed: a failed or interrupted write leaves neither a partial OUT nor a damaged old one.
+    const std::filesystem::path out = files[1];
+    const std::filesystem::path partial =
+        out.parent_path() / ("." + out.stem().string() + ".partial" + out.extension().string());
+    try {
+      write_mesh(result.soup, partial.string(), options);
+      stop_if_interrupted();
+      std::filesystem::rename(partial, out);
+    } catch (...) {
+      std::error_code ignored;
+      std::filesystem::remove(partial, ignored);
+      throw;
+    }
+  }
+  bar.finish();
   std::fputs(json ? (result.report.to_json() + "\n").c_str() : result.report.to_text().c_str(), stdout);
   return 0;
 }
@@ -275,7 +306,11 @@ int main(int argc, char** argv) {
     if (command == "distance") return distance_command(args);
     if (command == "list") return list(args);
     if (command == "help") return help(args);
+    cli::install_interrupt_handler();
     return run(command, args);
+  } catch (const Cancelled& e) {
+    std::fprintf(stderr, "hedge: %s\n", e.what());
+    return 130;  // what shells report for a process ended by SIGINT
   } catch (const std::exception& e) {
     std::fprintf(stderr, "hedge: %s\n", e.what());
     return 1;
