@@ -181,6 +181,8 @@ struct OpEntry {
 std::vector<OpEntry> hedge_operations();
 std::vector<OpEntry> openmesh_operations();
 std::vector<OpEntry> cgal_operations();
+std::vector<OpEntry> meshopt_simplify_operations();  // meshopt_simplify
+std::vector<OpEntry> meshopt_sloppy_operations();    // meshopt_simplifySloppy, the lower bound of time
 
 //! Runs the operation table (and, with `hosts`, MeshLab and Blender as separate processes);
 //! returns the process exit code.

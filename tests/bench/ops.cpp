@@ -409,7 +409,11 @@ int run_operation_table(int reps, bool hosts, const std::vector<std::string>& on
 
   std::vector<Row> rows;
   const std::vector<std::pair<std::string, std::vector<OpEntry>>> libraries = {
-      {"hedge", hedge_operations()}, {"OpenMesh", openmesh_operations()}, {"CGAL", cgal_operations()}};
+      {"hedge", hedge_operations()},
+      {"OpenMesh", openmesh_operations()},
+      {"CGAL", cgal_operations()},
+      {"meshopt_simplify", meshopt_simplify_operations()},
+      {"meshopt_simplifySloppy", meshopt_sloppy_operations()}};
   std::fprintf(stderr, "operations on %s, %d run(s) each:\n", mesh_name.c_str(), reps);
   for (const char* op : kTableOps) {
     if (!only.empty() && std::find(only.begin(), only.end(), op) == only.end()) continue;
