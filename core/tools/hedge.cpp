@@ -210,6 +210,31 @@ int help(const std::vector<std::string>& args) {
   return 0;
 }
 
+// Writes beside `path` under a hidden name with its extension (which picks the format), then
+// renames: a failed or interrupted (Ctrl-C) write leaves neither a partial file nor a damaged older one.
+void write_whole_or_nothing(const Soup& soup, const std::string& path, const WriteOptions& options) {
+  const std::filesystem::path out = path;
+  const std::string partial =
+      (out.parent_path() / ("." + out.stem().string() + ".partial" + out.extension().string())).string();
+  const auto discard_partial = [&] {
+    std::error_code ignored;
+    std::filesystem::remove(partial, ignored);
+  };
+  try {
+    write_mesh(soup, partial, options);
+    if (cli::interrupted()) throw Cancelled();
+    std::filesystem::rename(partial, out);
+  } catch (const Cancelled&) {
+    discard_partial();
+    throw;
+  } catch (const std::exception& e) {
+    discard_partial();
+    std::string message = e.what();  // name the file the user asked for, not the hidden one
+    if (const auto at = message.find(partial); at != std::string::npos) message.replace(at, partial.size(), path);
+    throw Error(message);
+  }
+}
+
 int run(const std::string& id, const std::vector<std::string>& args) {
   const Operation& op = find_operation(id);
   std::vector<std::string> files;
@@ -246,31 +271,15 @@ int run(const std::string& id, const std::vector<std::string>& args) {
   ParamValues params = resolve_params(op, given);  // refuse bad parameters before reading anything
   if (op.changes_mesh) format_from_path(files[1]);
   cli::TerminalProgress bar(!quiet);
-  const auto stop_if_interrupted = [] {
-    if (cli::interrupted()) throw Cancelled();
-  };
   const auto file_name = [](const std::string& path) { return std::filesystem::path(path).filename().string(); };
   bar.update(0, "reading " + file_name(files[0]));
   Soup soup = read_mesh(files[0]);
-  stop_if_interrupted();  // reading does not look at the flag itself
+  if (cli::interrupted()) throw Cancelled();  // reading does not look at the flag itself
   Progress progress([&](double fraction, const std::string& stage) { return bar.update(fraction, stage); });
   RunResult result = run_operation(op, soup, params, progress);
   if (op.changes_mesh) {
     bar.update(1, "writing " + file_name(files[1]));
-    // Written beside OUT under a hidden name with OUT's extension (which picks the format), then
-    // renamed: a failed or interrupted write leaves neither a partial OUT nor a damaged old one.
-    const std::filesystem::path out = files[1];
-    const std::filesystem::path partial =
-        out.parent_path() / ("." + out.stem().string() + ".partial" + out.extension().string());
-    try {
-      write_mesh(result.soup, partial.string(), options);
-      stop_if_interrupted();
-      std::filesystem::rename(partial, out);
-    } catch (...) {
-      std::error_code ignored;
-      std::filesystem::remove(partial, ignored);
-      throw;
-    }
+    write_whole_or_nothing(result.soup, files[1], options);
   }
   bar.finish();
   std::fputs(json ? (result.report.to_json() + "\n").c_str() : result.report.to_text().c_str(), stdout);

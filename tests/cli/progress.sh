@@ -122,5 +122,10 @@ if stdout or open(out).read() != "an older result\n":
 leftovers = sorted(set(os.listdir(work)) - {"small.off", "cancelled_pipe.ply"})
 if leftovers:
     fail(f"partial files left behind: {leftovers}")
+# OUT is written under a hidden name and renamed; a failed write still names the file asked for.
+missing = f"{work}/no/such/dir/out.off"
+failed = subprocess.run([hedge, "decimate", bunny, missing], capture_output=True, timeout=120)
+if failed.returncode != 1 or failed.stderr.decode().strip() != f"hedge: cannot write {missing}: No such file or directory":
+    fail(f"a write into a missing folder: exit {failed.returncode}, stderr {failed.stderr!r}")
 print("progress and Ctrl-C: ok")
 PY
