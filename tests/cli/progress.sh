@@ -12,7 +12,7 @@ for mesh in bunny.off dragon_res2.ply; do
 done
 
 python3 - "$HEDGE" "$MESHES" "$work" <<'PY'
-import os, pty, signal, subprocess, sys, time
+import os, pty, select, signal, subprocess, sys, time
 
 hedge, meshes, work = sys.argv[1:]
 bunny, dragon = f"{meshes}/bunny.off", f"{meshes}/dragon_res2.ply"
@@ -23,9 +23,11 @@ def fail(message):
 
 
 def read_available(fd, until=None, timeout=120):
-    """Reads the pty until the child closes it (or `until` appears); EIO means closed."""
+    """Reads the pty until the child closes it, `until` appears or `timeout` passes; EIO means closed."""
     text, deadline = b"", time.monotonic() + timeout
-    while time.monotonic() < deadline:
+    while (left := deadline - time.monotonic()) > 0:
+        if not select.select([fd], [], [], left)[0]:
+            break
         try:
             chunk = os.read(fd, 4096)
         except OSError:
@@ -36,6 +38,16 @@ def read_available(fd, until=None, timeout=120):
         if until and until in text:
             break
     return text.decode(errors="replace")
+
+
+def cancelled_within(child, seconds, what):
+    """The exit code once the child has ended, `seconds` at most after the SIGINT it was sent."""
+    try:
+        return child.wait(timeout=seconds)
+    except subprocess.TimeoutExpired:
+        child.kill()
+        child.wait()
+        fail(f"{what}: still running {seconds} s after Ctrl-C")
 
 
 def start_on_pty(args):
@@ -81,19 +93,19 @@ piped = subprocess.run([hedge, "decimate", bunny, out, "--target-ratio", "0.2"],
 if piped.returncode != 0 or piped.stderr:
     fail(f"decimate with stderr a pipe: exit {piped.returncode}, stderr {piped.stderr!r}")
 
-# Ctrl-C while the operation runs (seen on the terminal): the cancel path, exit 130, no OUT.
-long_run = ["remesh", dragon, None, "--iterations", "50"]
+# Ctrl-C while the operation runs (seen on the terminal): the cancel path, exit 130, no OUT. The
+# whole run takes minutes; cancelled, it ends at the operation's next progress report, well within 10 s.
 out = f"{work}/cancelled_pty.ply"
-long_run[2] = out
-child, master = start_on_pty(long_run)
+long_run = lambda mesh, out: ["remesh", mesh, out, "--iterations", "100"]
+child, master = start_on_pty(long_run(f"{meshes}/dragon.ply", out))
 seen = read_available(master, until=b"splitting long edges")
 if "splitting long edges" not in seen:
     child.kill()
     fail(f"remesh never reached its first round: {seen!r}")
 started = time.monotonic()
 child.send_signal(signal.SIGINT)
-rest = read_available(master)
-child.wait(timeout=120)
+rest = read_available(master, timeout=10)
+cancelled_within(child, 10, "Ctrl-C on a pty")
 os.close(master)
 if child.returncode != 130:
     fail(f"Ctrl-C on a pty: exit {child.returncode}, stderr {rest!r}")
@@ -106,15 +118,15 @@ print(f"cancelled on a pty {time.monotonic() - started:.2f} s after Ctrl-C")
 # A plain SIGINT with no terminal at all (--quiet, stderr a pipe): cancelled the same way, and an
 # OUT that was there before is left as it was.
 out = f"{work}/cancelled_pipe.ply"
-long_run[2] = out
 with open(out, "w") as f:
     f.write("an older result\n")
-child = subprocess.Popen([hedge] + long_run + ["--quiet"], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
-time.sleep(1.0)
+child = subprocess.Popen([hedge] + long_run(dragon, out) + ["--quiet"], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+time.sleep(1.5)
 if child.poll() is not None:
     fail(f"remesh ended before the SIGINT: exit {child.returncode}")
 child.send_signal(signal.SIGINT)
-stdout, stderr = child.communicate(timeout=120)
+cancelled_within(child, 10, "SIGINT with a pipe")
+stdout, stderr = child.stdout.read(), child.stderr.read()
 if child.returncode != 130 or stderr.decode().strip() != "hedge: cancelled by the user":
     fail(f"SIGINT with a pipe: exit {child.returncode}, stderr {stderr!r}")
 if stdout or open(out).read() != "an older result\n":
@@ -122,6 +134,7 @@ if stdout or open(out).read() != "an older result\n":
 leftovers = sorted(set(os.listdir(work)) - {"small.off", "cancelled_pipe.ply"})
 if leftovers:
     fail(f"partial files left behind: {leftovers}")
+
 # OUT is written under a hidden name and renamed; a failed write still names the file asked for.
 missing = f"{work}/no/such/dir/out.off"
 failed = subprocess.run([hedge, "decimate", bunny, missing], capture_output=True, timeout=120)
