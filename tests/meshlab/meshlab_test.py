@@ -12,6 +12,9 @@ import sys
 import time
 from xml.sax.saxutils import quoteattr
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "hostile"))
+import defects  # noqa: E402
+
 
 def parse_args(extra=None):
     parser = argparse.ArgumentParser()
@@ -191,6 +194,17 @@ class MeshLab:
             f.write(output)
         return code, output, seconds
 
+    def apply_started(self, mesh_in, mesh_out, filters, name, **kwargs):
+        """apply(), run again (3 runs at most) while meshlabserver dies before it loads any plugin:
+        once in a few hundred runs on a loaded machine its X connection fails (SIGPIPE, or Qt
+        "could not connect to display" and abort), and the run did not happen."""
+        for _ in range(3):
+            code, output, seconds = self.apply(mesh_in, mesh_out, filters, name, **kwargs)
+            if code in (0, self.filter_failed) or "Loading Plugins" in output or self.runner != "meshlabserver":
+                break
+            print(f"  NOTE  {name}: meshlabserver died before starting (exit {code}); run again")
+        return code, output, seconds
+
     def filters(self):
         """Every filter the runner has loaded: {name: {"info", "params": [{"type" (Rich...),
         "name", "label", "tooltip"}], and with hedge-mlx "python_name", "class", "arity",
@@ -242,6 +256,33 @@ class MeshLab:
         if done.returncode != 0:
             raise Failure(f"hedge report {path}: {done.stderr.strip()}")
         return json.loads(done.stdout)
+
+
+_counted = {}
+
+
+def count_defects(path):
+    """defects.count of a mesh file, remembered per file and modification time (inputs recur)."""
+    key = (path, os.stat(path).st_mtime_ns)
+    if key not in _counted:
+        _counted[key] = defects.count(defects.read_mesh(path)[1])
+    return _counted[key]
+
+
+def check_defects(checks, label, mesh_in, mesh_out):
+    """The saved result has no more defects of any category than the input file; returns the
+    two counts."""
+    before, after = count_defects(mesh_in), count_defects(mesh_out)
+    for passed, message in defects.verdicts(label, before, after):
+        checks.check(passed, message)
+    return before, after
+
+
+def write_table(ml, table, file_name):
+    """Prints an outcomes.Table and writes it as Markdown into the test's folder."""
+    print(table.markdown())
+    with open(ml.path(file_name), "w") as f:
+        f.write(table.markdown())
 
 
 def parse_doxygen_dump(text):

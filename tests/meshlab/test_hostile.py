@@ -90,17 +90,11 @@ def main():
         def one(case, path, op):
             name = f"{case.name}.{op['id']}"
             out = ml.path(name + ".ply")
-            for attempt in range(3):
-                try:
-                    code, output, seconds = ml.apply(path, out, [mt.hedge_filter(ml, op["id"])], name, timeout=TIMEOUT)
-                except mt.Failure as e:
-                    return case, op, out, None, str(e), TIMEOUT
-                # Once in a few hundred runs on a loaded machine, meshlabserver dies before it
-                # loads any plugin (SIGPIPE, or Qt "could not connect to display" and abort): its
-                # X connection failed, the run did not happen; run it again.
-                if code in (0, ml.filter_failed) or "Loading Plugins" in output or ml.runner != "meshlabserver":
-                    break
-                print(f"  NOTE  {name}: meshlabserver died before starting (exit {code}); run again")
+            try:
+                code, output, seconds = ml.apply_started(path, out, [mt.hedge_filter(ml, op["id"])], name,
+                                                         timeout=TIMEOUT)
+            except mt.Failure as e:
+                return case, op, out, None, str(e), TIMEOUT
             return case, op, out, code, output, seconds
 
         refused, refused_code = IMPORT_REFUSED[ml.runner]
@@ -157,9 +151,7 @@ def main():
                 checks.check(expected is None, f"{label}: succeeded, expected a refusal with {expected!r}")
                 if case.name in IMPORT_TRIANGULATES:
                     table.set(case.name, op["id"], table.get(case.name, op["id"]) + " (triangulated by MeshLab's reader)")
-        print(table.markdown())
-        with open(ml.path("hostile_table.md"), "w") as f:
-            f.write(table.markdown())
+        mt.write_table(ml, table, "hostile_table.md")
     finally:
         ml.close()
     checks.finish()

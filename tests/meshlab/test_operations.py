@@ -1,7 +1,9 @@
 """Every catalogue operation as a Hedge filter in a meshlabserver .mlx script, on real meshes,
-with the result read back from the saved file (hedge info/report) and from MeshLab's log; and a
-script chaining three Hedge filters with MeshLab's own filters."""
+with the result read back from the saved file (hedge info/report) and from MeshLab's log, and no
+more defects in it than in the input (tests/hostile/defects.py); and a script chaining three
+Hedge filters with MeshLab's own filters."""
 import filecmp
+import os
 
 import mesh_files
 import meshlab_test as mt
@@ -16,6 +18,8 @@ def run(ml, checks, name, mesh_in, filters, save_flags=None):
         print(output[-2000:])
     elif ml.runner == "hedge-mlx":
         check_returned(ml, checks, name, output, filters)
+    if ok and all(f.startswith("Hedge: ") for f, _ in filters):  # MeshLab's own filters promise nothing
+        mt.check_defects(checks, f"{name} on {os.path.basename(mesh_in)}", mesh_in, out)
     return out if ok else None, output
 
 
