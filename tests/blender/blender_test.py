@@ -149,6 +149,40 @@ def mesh_arrays(me):
     return out
 
 
+def object_from_pydata(name, vertices, faces):
+    """A new, selected and active object of a mesh built with from_pydata (which keeps every face
+    as given: duplicates, non-manifold edges)."""
+    me = bpy.data.meshes.new(name)
+    me.from_pydata(vertices, [], faces)
+    obj = bpy.data.objects.new(name, me)
+    bpy.context.collection.objects.link(obj)
+    select_only(obj)
+    return obj
+
+
+def faces_of(me):
+    """The polygons as tuples of vertex indices."""
+    nl, nf = len(me.loops), len(me.polygons)
+    corners = get(me.loops, "vertex_index", nl, np.int32).tolist()
+    starts = get(me.polygons, "loop_start", nf, np.int32).tolist()
+    totals = get(me.polygons, "loop_total", nf, np.int32).tolist()
+    return [tuple(corners[s:s + t]) for s, t in zip(starts, totals)]
+
+
+def problems(me):
+    """Whether Mesh.validate() would change anything, asked of a copy. The copy's positions are
+    its own first: Blender 4.3.2's validate() of a copy writes through to the original's
+    implicitly shared positions (a NaN in the original became 0.0)."""
+    copy = me.copy()
+    try:
+        co = np.empty(len(copy.vertices) * 3, np.float32)
+        copy.vertices.foreach_get("co", co)
+        copy.vertices.foreach_set("co", co)
+        return bool(copy.validate(verbose=False))
+    finally:
+        bpy.data.meshes.remove(copy)
+
+
 def counts(me):
     return len(me.vertices), len(me.edges), len(me.polygons)
 

@@ -15,7 +15,8 @@ sys.path.insert(0, os.path.join(HERE, "..", "hostile"))
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 import unittest  # noqa: E402
-from blender_test import ARGS, clear_scene, install_addon, mesh_arrays, run_tests, select_only  # noqa: E402
+from blender_test import (ARGS, clear_scene, install_addon, mesh_arrays, object_from_pydata, problems,  # noqa: E402
+                          run_tests)
 import hostile_meshes  # noqa: E402
 import limits  # noqa: E402
 import outcomes  # noqa: E402
@@ -24,26 +25,7 @@ hedge = install_addon()
 
 
 def object_from(case):
-    me = bpy.data.meshes.new(case.name)
-    me.from_pydata(case.vertices, [], case.faces)
-    obj = bpy.data.objects.new(case.name, me)
-    bpy.context.collection.objects.link(obj)
-    select_only(obj)
-    return obj
-
-
-def problems(me):
-    """Whether Mesh.validate() would change anything, asked of a copy. The copy's positions are
-    its own first: Blender 4.3.2's validate() of a copy writes through to the original's
-    implicitly shared positions (a NaN in the original became 0.0)."""
-    copy = me.copy()
-    try:
-        co = np.empty(len(copy.vertices) * 3, np.float32)
-        copy.vertices.foreach_get("co", co)
-        copy.vertices.foreach_set("co", co)
-        return bool(copy.validate(verbose=False))
-    finally:
-        bpy.data.meshes.remove(copy)
+    return object_from_pydata(case.name, case.vertices, case.faces)
 
 
 def same(before, after):
