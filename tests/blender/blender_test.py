@@ -170,14 +170,19 @@ def faces_of(me):
 
 
 def problems(me):
-    """Whether Mesh.validate() would change anything, asked of a copy. The copy's positions are
-    its own first: Blender 4.3.2's validate() of a copy writes through to the original's
-    implicitly shared positions (a NaN in the original became 0.0)."""
+    """Whether Mesh.validate() would change anything, asked of a copy. The copy's arrays are its
+    own first (each written back): Blender 4.3.2's validate() of a copy writes through to the
+    original's implicitly shared arrays (a NaN position in the original became 0.0; the corners of
+    a mesh with duplicate faces were rewired)."""
     copy = me.copy()
     try:
-        co = np.empty(len(copy.vertices) * 3, np.float32)
-        copy.vertices.foreach_get("co", co)
-        copy.vertices.foreach_set("co", co)
+        for collection, prop, dtype, comps in ((copy.vertices, "co", np.float32, 3), (copy.edges, "vertices", np.int32, 2),
+                                               (copy.loops, "vertex_index", np.int32, 1),
+                                               (copy.loops, "edge_index", np.int32, 1),
+                                               (copy.polygons, "loop_start", np.int32, 1)):
+            values = get(collection, prop, len(collection), dtype, comps)
+            if len(values):
+                collection.foreach_set(prop, values)
         return bool(copy.validate(verbose=False))
     finally:
         bpy.data.meshes.remove(copy)
