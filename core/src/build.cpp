@@ -18,6 +18,7 @@
 #include "hedge/error.h"
 #include "hedge/limits.h"
 #include "hedge/threads.h"
+#include "weld.h"
 
 #ifdef __linux__
 #include <sys/mman.h>
@@ -1277,6 +1278,7 @@ Soup extract(const Mesh& mesh, const ExtractOptions& options, ExtractReport* rep
         vmap[by_source[i].second] = n_out - 1;
       }
     }
+    const std::uint32_t n_sourced = n_out;
     for (Vertex v : mesh.vertices())
       if (vmap[v.idx()] == kInv) {
         vmap[v.idx()] = n_out++;
@@ -1288,7 +1290,14 @@ Soup extract(const Mesh& mesh, const ExtractOptions& options, ExtractReport* rep
         vmap[v] = n_out++;
         order.push_back(v);
       }
-      if (report) report->copies_kept_apart = apart.size();
+      std::size_t kept_apart = apart.size();
+      if (options.input) {
+        detail::Weld weld{std::move(vmap), std::move(order), n_sourced};
+        kept_apart += detail::keep_new_defects_apart(mesh, source->vector(), *options.input, weld);
+        vmap = std::move(weld.vmap);
+        order = std::move(weld.order);
+      }
+      if (report) report->copies_kept_apart = kept_apart;
     }
   }
   const std::size_t n_out_vertices = vertices_identity ? nvs : order.size();

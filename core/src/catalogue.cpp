@@ -305,11 +305,14 @@ RunResult run_operation(const Operation& op, const Soup& input, const ParamValue
     check_valid(built.mesh, op.id);
     progress.update(1.0, "writing the result");
     ExtractReport extracted;
-    result.soup = extract(built.mesh, {}, &extracted);
+    ExtractOptions options;
+    options.input = &input;
+    result.soup = extract(built.mesh, options, &extracted);
     if (extracted.copies_kept_apart)
       result.report.messages.push_back("kept " + std::to_string(extracted.copies_kept_apart) +
-                                       " copies of non-manifold vertices apart: welding them would have made a "
-                                       "face use one vertex twice");
+                                       " copies of non-manifold vertices apart: welding them back would have made "
+                                       "a defect the input did not have (a face using one vertex twice, a "
+                                       "non-manifold edge or vertex, a duplicate face)");
   }
   double seconds = std::chrono::duration<double>(Clock::now() - start).count();
   result.report.add("seconds", seconds);

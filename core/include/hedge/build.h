@@ -57,11 +57,15 @@ BuildResult build(const Soup& soup, const BuildOptions& options = {});
 struct ExtractOptions {
   //! Weld the copies made by build() back into their source vertex, and undo its flips.
   bool restore_source = true;
+  //! The soup build() was given, when there is one: copies whose weld would make a
+  //! non-manifold edge or vertex or a duplicate face that this soup did not have stay apart.
+  const Soup* input = nullptr;
 };
 
 struct ExtractReport {
-  //! Vertex copies not welded back because an operation brought two copies of one source
-  //! vertex into one face; they come after every other vertex, in mesh order.
+  //! Vertex copies not welded back because welding them would have made a defect: a face
+  //! using one vertex twice, or (given ExtractOptions::input) a non-manifold edge or vertex
+  //! or a duplicate face the input did not have. They come after every other vertex.
   std::size_t copies_kept_apart = 0;
 };
 
@@ -70,6 +74,8 @@ struct ExtractReport {
 //! grouped by domain (vertex, then face, then corner), each group in the soup's order, so
 //! a soup that lists its channels that way round-trips exactly. No output face visits a
 //! vertex twice: copies that would weld into one within a face stay apart (ExtractReport).
+//! Given the input soup, the output also has no more non-manifold edges and vertices and
+//! duplicate faces than it (docs/architecture.md, "No mesh comes back worse").
 Soup extract(const Mesh& mesh, const ExtractOptions& options = {}, ExtractReport* report = nullptr);
 
 }  // namespace hedge

@@ -1,0 +1,381 @@
+// extract()'s guard on the weld (weld.h), as passes over the faces around welded copies:
+//   1. watch: the output vertices that weld two or more copies of an input vertex;
+//   2. baseline: the input's defects around those vertices;
+//   3. repeat until nothing moves: find the output's defects there, and for each one the
+//      input did not have, give the copies that make it their own output vertex.
+// Moving a copy out of a weld never makes an edge carry more faces or two faces one vertex
+// set; a vertex it leaves with two fans is split in the next pass. Every move makes a weld
+// smaller, so the passes stop.
+#include "weld.h"
+
+#include <algorithm>
+#include <numeric>
+#include <tuple>
+#include <utility>
+
+namespace hedge::detail {
+namespace {
+
+using Key = std::uint64_t;
+//! Keys of vertices that weld nothing start here (output vertex + kOwnKey): never an input id.
+constexpr Key kOwnKey = Key(1) << 32;
+
+//! Polygons over vertex keys; per corner, whether its vertex is watched and (for the output)
+//! the mesh vertex it stands for.
+struct Faces {
+  std::vector<Key> keys;
+  std::vector<char> watched;
+  std::vector<std::uint32_t> mesh_vertex;
+  std::vector<std::uint32_t> start{0};
+
+  std::size_t size() const { return start.size() - 1; }
+  std::uint32_t next(std::uint32_t c, std::size_t f) const { return c + 1 == start[f + 1] ? start[f] : c + 1; }
+  bool any_watched(std::size_t f) const {
+    return std::any_of(watched.begin() + start[f], watched.begin() + start[f + 1], [](char w) { return w; });
+  }
+  std::vector<Key> key_set(std::size_t f) const {
+    std::vector<Key> set(keys.begin() + start[f], keys.begin() + start[f + 1]);
+    std::sort(set.begin(), set.end());
+    set.erase(std::unique(set.begin(), set.end()), set.end());
+    return set;
+  }
+};
+
+//! A face side between two different keys, one of them watched; `corner` is where it starts.
+struct Side {
+  Key lo, hi;
+  std::uint32_t face, corner;
+};
+
+//! The defects around watched vertices.
+struct Defects {
+  std::vector<Side> sides;                                        // by (lo, hi, face)
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> nm_edges;  // runs of 3+ sides in `sides`
+  struct Fans {
+    Key key;
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> faces;  // (face, fan), fans numbered from 0
+  };
+  std::vector<Fans> nm_vertices;
+  std::vector<std::vector<std::uint32_t>> duplicates;  // faces sharing one key set, ascending
+};
+
+Defects find_defects(const Faces& faces) {
+  Defects d;
+  for (std::uint32_t f = 0; f < faces.size(); ++f)
+    for (std::uint32_t c = faces.start[f]; c < faces.start[f + 1]; ++c) {
+      const std::uint32_t n = faces.next(c, f);
+      const Key a = faces.keys[c], b = faces.keys[n];
+      if (a != b && (faces.watched[c] || faces.watched[n])) d.sides.push_back({std::min(a, b), std::max(a, b), f, c});
+    }
+  std::sort(d.sides.begin(), d.sides.end(), [](const Side& x, const Side& y) {
+    return std::tie(x.lo, x.hi, x.face, x.corner) < std::tie(y.lo, y.hi, y.face, y.corner);
+  });
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> runs;  // sides of one edge
+  for (std::uint32_t i = 0; i < d.sides.size();) {
+    std::uint32_t j = i + 1;
+    while (j < d.sides.size() && d.sides[j].lo == d.sides[i].lo && d.sides[j].hi == d.sides[i].hi) ++j;
+    runs.emplace_back(i, j);
+    if (j - i >= 3) d.nm_edges.emplace_back(i, j);
+    i = j;
+  }
+
+  // Fans: a watched vertex's faces are one fan when edges through the vertex join them.
+  std::vector<std::pair<Key, std::uint32_t>> incidences;  // (key, face)
+  for (std::uint32_t f = 0; f < faces.size(); ++f)
+    for (std::uint32_t c = faces.start[f]; c < faces.start[f + 1]; ++c)
+      if (faces.watched[c]) incidences.emplace_back(faces.keys[c], f);
+  std::sort(incidences.begin(), incidences.end());
+  incidences.erase(std::unique(incidences.begin(), incidences.end()), incidences.end());
+  std::vector<std::uint32_t> parent(incidences.size());
+  std::iota(parent.begin(), parent.end(), 0u);
+  auto root = [&](std::uint32_t x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  auto incidence = [&](Key key, std::uint32_t f) -> std::uint32_t {
+    auto it = std::lower_bound(incidences.begin(), incidences.end(), std::make_pair(key, f));
+    return it != incidences.end() && *it == std::make_pair(key, f) ? std::uint32_t(it - incidences.begin()) : ~0u;
+  };
+  for (auto [i, j] : runs)
+    for (const Key end : {d.sides[i].lo, d.sides[i].hi}) {
+      const std::uint32_t first = incidence(end, d.sides[i].face);
+      if (first == ~0u) continue;  // not watched
+      for (std::uint32_t k = i + 1; k < j; ++k) parent[root(incidence(end, d.sides[k].face))] = root(first);
+    }
+  for (std::uint32_t i = 0; i < incidences.size();) {
+    std::uint32_t j = i;
+    while (j < incidences.size() && incidences[j].first == incidences[i].first) ++j;
+    std::vector<std::uint32_t> roots;
+    for (std::uint32_t k = i; k < j; ++k) roots.push_back(root(k));
+    std::vector<std::uint32_t> distinct = roots;
+    std::sort(distinct.begin(), distinct.end());
+    distinct.erase(std::unique(distinct.begin(), distinct.end()), distinct.end());
+    if (distinct.size() > 1) {
+      Defects::Fans fans{incidences[i].first, {}};
+      for (std::uint32_t k = i; k < j; ++k)
+        fans.faces.emplace_back(
+            incidences[k].second,
+            std::uint32_t(std::lower_bound(distinct.begin(), distinct.end(), roots[k - i]) - distinct.begin()));
+      d.nm_vertices.push_back(std::move(fans));
+    }
+    i = j;
+  }
+
+  // Duplicates: faces with a watched vertex and one key set.
+  std::vector<std::pair<std::vector<Key>, std::uint32_t>> sets;
+  for (std::uint32_t f = 0; f < faces.size(); ++f)
+    if (faces.any_watched(f)) sets.emplace_back(faces.key_set(f), f);
+  std::sort(sets.begin(), sets.end());
+  for (std::size_t i = 0; i < sets.size();) {
+    std::size_t j = i + 1;
+    while (j < sets.size() && sets[j].first == sets[i].first) ++j;
+    if (j - i > 1) {
+      d.duplicates.emplace_back();
+      for (std::size_t k = i; k < j; ++k) d.duplicates.back().push_back(sets[k].second);
+    }
+    i = j;
+  }
+  return d;
+}
+
+//! The input's defects as keys, to tell the output's new ones from those it came with.
+struct Baseline {
+  std::vector<std::pair<Key, Key>> nm_edges;
+  std::vector<Key> nm_vertices;
+  std::vector<std::vector<Key>> duplicates;
+
+  explicit Baseline(const Faces& faces) {
+    const Defects d = find_defects(faces);
+    for (auto [i, j] : d.nm_edges) nm_edges.emplace_back(d.sides[i].lo, d.sides[i].hi);
+    for (const auto& fans : d.nm_vertices) nm_vertices.push_back(fans.key);
+    for (const auto& group : d.duplicates) duplicates.push_back(faces.key_set(group[0]));
+    std::sort(nm_edges.begin(), nm_edges.end());
+    std::sort(nm_vertices.begin(), nm_vertices.end());
+    std::sort(duplicates.begin(), duplicates.end());
+  }
+  template <class T>
+  static bool has(const std::vector<T>& sorted, const T& value) {
+    return std::binary_search(sorted.begin(), sorted.end(), value);
+  }
+};
+
+class Guard {
+ public:
+  Guard(const Mesh& mesh, const std::vector<std::uint32_t>& source, const Soup& input, Weld& weld)
+      : mesh_(mesh),
+        source_(source),
+        input_(input),
+        weld_(weld),
+        group_size_(weld.order.size(), 0),
+        moved_flag_(mesh.vertices_size(), 0) {
+    for (Vertex v : mesh.vertices()) ++group_size_[weld.vmap[v.idx()]];
+  }
+
+  std::size_t run() {
+    if (!watch()) return 0;
+    const Baseline baseline(input_faces());
+    std::size_t moved = 0;
+    for (;;) {
+      for (std::uint32_t v : moved_now_) moved_flag_[v] = 0;
+      moved_now_.clear();
+      const Faces faces = output_faces();
+      const Defects found = find_defects(faces);
+      const std::size_t before = moved;
+      for (auto [i, j] : found.nm_edges) {
+        const Side& s = found.sides[i];
+        if (!ours(s.lo) || !ours(s.hi) || Baseline::has(baseline.nm_edges, {s.lo, s.hi})) continue;
+        moved += split_edge(faces, found, i, j);
+      }
+      for (const auto& fans : found.nm_vertices)
+        if (!Baseline::has(baseline.nm_vertices, fans.key)) moved += split_fans(faces, fans);
+      for (const auto& group : found.duplicates) {
+        const std::vector<Key> set = faces.key_set(group[0]);
+        if (std::all_of(set.begin(), set.end(), [&](Key k) { return ours(k); }) &&
+            !Baseline::has(baseline.duplicates, set))
+          moved += split_duplicate(faces, group);
+      }
+      if (moved == before) return moved;
+    }
+  }
+
+ private:
+  // ---- pass 1: watch -----------------------------------------------------------------
+  //! Marks the input vertices whose copies weld, and the mesh faces around them.
+  bool watch() {
+    watched_input_.assign(input_.n_vertices(), 0);
+    bool any = false;
+    for (std::uint32_t o = 0; o < weld_.n_sourced; ++o) {
+      if (group_size_[o] < 2) continue;
+      any = true;
+      if (const std::uint32_t s = source_[weld_.order[o]]; s < input_.n_vertices()) watched_input_[s] = 1;
+    }
+    if (!any) return false;
+    for (Face f : mesh_.faces())
+      for (Vertex v : mesh_.vertices(f))
+        if (watched(weld_.vmap[v.idx()])) {
+          suspects_.push_back(f);
+          break;
+        }
+    return true;
+  }
+  //! Welds two or more copies (of an input vertex, of an operation's own source, or of a fan
+  //! split off either).
+  bool watched(std::uint32_t o) const { return group_size_[o] >= 2; }
+  Key key(std::uint32_t o) const { return o < weld_.n_sourced ? Key(source_[weld_.order[o]]) : kOwnKey + o; }
+  //! False for a source an operation made (past the input's vertices): the non-manifold
+  //! edges and duplicate faces its welds make are the operation's own rule (subdivision
+  //! splits such an edge in two, such a face in four). Its non-manifold vertices are not.
+  bool ours(Key k) const { return k >= kOwnKey || k < input_.n_vertices(); }
+  bool representative(std::uint32_t v) const { return weld_.order[weld_.vmap[v]] == v; }
+
+  // ---- pass 2: baseline --------------------------------------------------------------
+  Faces input_faces() const {
+    Faces faces;
+    const std::vector<std::size_t> offsets = input_.face_offsets();
+    for (std::size_t f = 0; f < input_.n_faces(); ++f) {
+      const auto first = input_.corners.begin() + offsets[f], last = input_.corners.begin() + offsets[f + 1];
+      if (std::none_of(first, last, [&](std::uint32_t v) { return watched_input_[v]; })) continue;
+      for (auto it = first; it != last; ++it) {
+        faces.keys.push_back(*it);
+        faces.watched.push_back(watched_input_[*it]);
+      }
+      faces.start.push_back(std::uint32_t(faces.keys.size()));
+    }
+    return faces;
+  }
+
+  // ---- pass 3: find and split --------------------------------------------------------
+  Faces output_faces() const {
+    Faces faces;
+    for (Face f : suspects_) {
+      for (Vertex v : mesh_.vertices(f)) {
+        const std::uint32_t o = weld_.vmap[v.idx()];
+        faces.keys.push_back(key(o));
+        faces.watched.push_back(watched(o));
+        faces.mesh_vertex.push_back(v.idx());
+      }
+      faces.start.push_back(std::uint32_t(faces.keys.size()));
+    }
+    return faces;
+  }
+
+  //! Gives mesh vertex v an output vertex of its own.
+  std::size_t move(std::uint32_t v) { return move_all({v}); }
+  std::size_t move_all(const std::vector<std::uint32_t>& vs) {
+    for (std::uint32_t v : vs) {
+      moved_flag_[v] = 1;
+      moved_now_.push_back(v);
+    }
+    const std::uint32_t o = std::uint32_t(weld_.order.size());
+    weld_.order.push_back(vs.front());
+    group_size_.push_back(0);
+    for (std::uint32_t v : vs) {
+      --group_size_[weld_.vmap[v]];
+      weld_.vmap[v] = o;
+      ++group_size_[o];
+    }
+    return vs.size();
+  }
+  bool movable(std::uint32_t v) const { return !representative(v); }
+  //! True when a defect found at the start of this pass involves a copy moved since: it is
+  //! looked at again in the next pass, as it is then.
+  template <class Range>
+  bool stale(const Range& vertices) const {
+    return std::any_of(vertices.begin(), vertices.end(), [&](std::uint32_t v) { return moved_flag_[v]; });
+  }
+
+  //! A new edge of 3+ faces: keeps the mesh edge with the most representatives welded and
+  //! moves an end of each other one that it does not share.
+  std::size_t split_edge(const Faces& faces, const Defects& d, std::uint32_t i, std::uint32_t j) {
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> edges;
+    for (std::uint32_t k = i; k < j; ++k) {
+      const Side& s = d.sides[k];
+      const std::uint32_t a = faces.mesh_vertex[s.corner], b = faces.mesh_vertex[faces.next(s.corner, s.face)];
+      edges.emplace_back(std::min(a, b), std::max(a, b));
+    }
+    std::sort(edges.begin(), edges.end());
+    edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+    std::vector<std::uint32_t> ends;
+    for (auto e : edges) ends.insert(ends.end(), {e.first, e.second});
+    if (stale(ends)) return 0;
+    auto reps = [&](auto e) { return int(representative(e.first)) + int(representative(e.second)); };
+    const auto keep = *std::max_element(edges.begin(), edges.end(), [&](auto x, auto y) { return reps(x) < reps(y); });
+    std::size_t moved = 0;
+    for (auto e : edges) {
+      if (e == keep) continue;
+      for (std::uint32_t v : {e.first, e.second})
+        if (v != keep.first && v != keep.second && movable(v)) {
+          moved += move(v);
+          break;
+        }
+    }
+    return moved;
+  }
+
+  //! A new vertex of 2+ fans: the fan of the weld's representative stays, each other fan
+  //! gets one output vertex for all its copies.
+  std::size_t split_fans(const Faces& faces, const Defects::Fans& fans) {
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> copies;  // (fan, mesh vertex)
+    for (auto [f, fan] : fans.faces)
+      for (std::uint32_t c = faces.start[f]; c < faces.start[f + 1]; ++c)
+        if (faces.keys[c] == fans.key) copies.emplace_back(fan, faces.mesh_vertex[c]);
+    std::sort(copies.begin(), copies.end());
+    copies.erase(std::unique(copies.begin(), copies.end()), copies.end());
+    std::vector<std::uint32_t> all;
+    for (auto [fan, v] : copies) all.push_back(v);
+    if (stale(all)) return 0;
+    std::uint32_t kept = copies.front().first;
+    for (auto [fan, v] : copies)
+      if (representative(v)) kept = fan;
+    std::size_t moved = 0;
+    for (std::size_t i = 0; i < copies.size();) {
+      std::size_t j = i;
+      std::vector<std::uint32_t> group;
+      while (j < copies.size() && copies[j].first == copies[i].first) group.push_back(copies[j++].second);
+      // A copy in two fans (only possible through a face that repeats it) stays.
+      if (copies[i].first != kept &&
+          std::none_of(group.begin(), group.end(), [&](std::uint32_t v) { return representative(v); }))
+        moved += move_all(group);
+      i = j;
+    }
+    return moved;
+  }
+
+  //! Faces made one by the weld: every face after the first moves one of its copies.
+  std::size_t split_duplicate(const Faces& faces, const std::vector<std::uint32_t>& group) {
+    std::vector<std::uint32_t> all(faces.mesh_vertex.begin() + faces.start[group[0]],
+                                   faces.mesh_vertex.begin() + faces.start[group[0] + 1]);
+    for (std::uint32_t f : group)
+      all.insert(all.end(), faces.mesh_vertex.begin() + faces.start[f], faces.mesh_vertex.begin() + faces.start[f + 1]);
+    if (stale(all)) return 0;
+    std::size_t moved = 0;
+    for (std::size_t k = 1; k < group.size(); ++k) {
+      const std::uint32_t f = group[k];
+      for (std::uint32_t c = faces.start[f]; c < faces.start[f + 1]; ++c)
+        if (faces.watched[c] && movable(faces.mesh_vertex[c])) {
+          moved += move(faces.mesh_vertex[c]);
+          break;
+        }
+    }
+    return moved;
+  }
+
+  const Mesh& mesh_;
+  const std::vector<std::uint32_t>& source_;
+  const Soup& input_;
+  Weld& weld_;
+  std::vector<std::uint32_t> group_size_;
+  std::vector<char> watched_input_;
+  std::vector<Face> suspects_;
+  std::vector<char> moved_flag_;
+  std::vector<std::uint32_t> moved_now_;
+};
+
+}  // namespace
+
+std::size_t keep_new_defects_apart(const Mesh& mesh, const std::vector<std::uint32_t>& source, const Soup& input,
+                                   Weld& weld) {
+  return Guard(mesh, source, input, weld).run();
+}
+
+}  // namespace hedge::detail
