@@ -60,14 +60,28 @@ def _non_manifold_vertices(faces):
     return sum(1 for n in fans.values() if n > 1)
 
 
-def verdicts(label, before, after):
-    """One (passed, message) per category: the result (`after`) has no more than the input."""
-    return [(after[k] <= before[k], f"{label}: {k} {before[k]} -> {after[k]}") for k in CATEGORIES]
+def allowed(before, subdivision_steps=0):
+    """The most of each category a result may have: the input's counts, except that each
+    subdivision step splits every non-manifold edge in two and every duplicated face in four
+    whose three inner edges the copies share (docs/architecture.md, "No mesh comes back worse")."""
+    most = dict(before)
+    for _ in range(subdivision_steps):
+        most["non_manifold_edges"] = 2 * most["non_manifold_edges"] + 3 * most["duplicate_faces"]
+        most["duplicate_faces"] *= 4
+    return most
 
 
-def increases(before, after):
-    """The categories that grew, as 'category b -> a' strings."""
-    return [f"{k} {before[k]} -> {after[k]}" for k in CATEGORIES if after[k] > before[k]]
+def verdicts(label, before, after, subdivision_steps=0):
+    """One (passed, message) per category: the result (`after`) has no more than allowed()."""
+    most = allowed(before, subdivision_steps)
+    return [(after[k] <= most[k], f"{label}: {k} {before[k]} -> {after[k]}" + (f" (at most {most[k]})" if most[k] != before[k] else ""))
+            for k in CATEGORIES]
+
+
+def increases(before, after, subdivision_steps=0):
+    """The categories past allowed(), as 'category b -> a' strings."""
+    most = allowed(before, subdivision_steps)
+    return [f"{k} {before[k]} -> {after[k]}" for k in CATEGORIES if after[k] > most[k]]
 
 
 def describe(counts):

@@ -269,11 +269,11 @@ def count_defects(path):
     return _counted[key]
 
 
-def check_defects(checks, label, mesh_in, mesh_out):
-    """The saved result has no more defects of any category than the input file; returns the
-    two counts."""
+def check_defects(checks, label, mesh_in, mesh_out, subdivision_steps=0):
+    """The saved result has no more defects of any category than the input file (but what
+    `subdivision_steps` may multiply: defects.allowed); returns the two counts."""
     before, after = count_defects(mesh_in), count_defects(mesh_out)
-    for passed, message in defects.verdicts(label, before, after):
+    for passed, message in defects.verdicts(label, before, after, subdivision_steps):
         checks.check(passed, message)
     return before, after
 
@@ -318,6 +318,17 @@ def hedge_filter(meshlab, op_id, **values):
         value = values.get(p["id"], default_value(p))
         params.append(param_xml(p, value))
     return op["filter"], params
+
+
+def subdivision_steps(meshlab, filters):
+    """How many subdivision steps a list of Hedge filters makes (their `iterations` added up)."""
+    name = meshlab.operations["subdivide"]["filter"]
+    steps = 0
+    for filter_name, params in filters:
+        if filter_name == name:
+            given = [re.search(r'value="(\d+)"', p) for p in params if 'name="iterations"' in p]
+            steps += int(given[0].group(1)) if given and given[0] else 1
+    return steps
 
 
 def hedge_filter_given(meshlab, op_id, **values):

@@ -56,8 +56,9 @@ def main():
                     print(output[-2000:])
                     table.set(name, column, f"exit {code}")
                     continue
-                before, after = mt.check_defects(checks, label, mesh, out)
-                worse = defects.increases(before, after)
+                steps = int(op is not None and op["id"] == "subdivide")  # its default: one step
+                before, after = mt.check_defects(checks, label, mesh, out, steps)
+                worse = defects.increases(before, after, steps)
                 table.set(name, column, defects.cell(after) + (" WORSE" if worse else ""))
         print(f"\n{defects.CELL_KEY}\n")
         mt.write_table(ml, table, "defects_table.md")

@@ -19,7 +19,7 @@ def run(ml, checks, name, mesh_in, filters, save_flags=None):
     elif ml.runner == "hedge-mlx":
         check_returned(ml, checks, name, output, filters)
     if ok and all(f.startswith("Hedge: ") for f, _ in filters):  # MeshLab's own filters promise nothing
-        mt.check_defects(checks, f"{name} on {os.path.basename(mesh_in)}", mesh_in, out)
+        mt.check_defects(checks, f"{name} on {os.path.basename(mesh_in)}", mesh_in, out, mt.subdivision_steps(ml, filters))
     return out if ok else None, output
 
 
