@@ -19,6 +19,8 @@ struct DefectCounts {
   std::size_t non_manifold_vertices = 0;  //!< vertices whose faces make more than one fan
   std::size_t duplicate_faces = 0;        //!< faces whose vertex set an earlier face has
   std::size_t repeating_faces = 0;        //!< faces that list one vertex more than once
+  std::size_t border_edges = 0;           //!< edges with one face side: not a defect, a hole's edge
+  std::size_t lone_face_edges = 0;        //!< border edges of faces with no neighbour (not holes to fill)
 
   static constexpr const char* kNames[] = {"non-manifold edges", "non-manifold vertices", "duplicate faces",
                                            "faces repeating a vertex"};
@@ -30,7 +32,8 @@ struct DefectCounts {
 
 inline std::ostream& operator<<(std::ostream& os, const DefectCounts& d) {
   return os << "nm edges " << d.non_manifold_edges << ", nm vertices " << d.non_manifold_vertices
-            << ", duplicate faces " << d.duplicate_faces << ", repeating faces " << d.repeating_faces;
+            << ", duplicate faces " << d.duplicate_faces << ", repeating faces " << d.repeating_faces
+            << " (border edges " << d.border_edges << ")";
 }
 
 inline DefectCounts count_defects(const Soup& soup) {
@@ -66,12 +69,19 @@ inline DefectCounts count_defects(const Soup& soup) {
     }
   std::sort(sides.begin(), sides.end(),
             [](const Side& x, const Side& y) { return std::tie(x.a, x.b, x.face) < std::tie(y.a, y.b, y.face); });
+  std::vector<char> shared(soup.n_faces(), 0);  // a face with a side another face has too
   for (std::size_t i = 0; i < sides.size();) {
     std::size_t j = i;
     while (j < sides.size() && sides[j].a == sides[i].a && sides[j].b == sides[i].b) ++j;
     if (j - i >= 3) ++d.non_manifold_edges;
+    if (j - i == 1) ++d.border_edges;
+    if (j - i > 1)
+      std::for_each(sides.begin() + std::ptrdiff_t(i), sides.begin() + std::ptrdiff_t(j),
+                    [&](const Side& side) { shared[side.face] = 1; });
     i = j;
   }
+  for (std::size_t f = 0; f < soup.n_faces(); ++f)
+    if (!shared[f]) d.lone_face_edges += soup.face_sizes[f];
 
   // Fans: at each vertex, faces that share an edge through it are one fan (union-find over
   // (vertex, face) incidences joined along each edge's sides, at both of its ends).

@@ -6,6 +6,7 @@
 // in four.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <iostream>
@@ -146,6 +147,43 @@ Soup book(int pages) {
   return s;
 }
 
+//! A real scan with holes that touch at a vertex: around every 400th vertex (far enough
+//! apart), two of its faces that share no edge are removed, so two holes meet there.
+Soup with_bowtie_holes(Soup soup) {
+  if (soup.n_faces() == 0) return soup;
+  const std::vector<std::size_t> offsets = soup.face_offsets();
+  std::vector<std::vector<std::uint32_t>> faces_of(soup.n_vertices());
+  for (std::uint32_t f = 0; f < soup.n_faces(); ++f)
+    for (std::size_t c = offsets[f]; c < offsets[f + 1]; ++c) faces_of[soup.corners[c]].push_back(f);
+  auto vertices = [&](std::uint32_t f) {
+    return std::vector<std::uint32_t>(soup.corners.begin() + offsets[f], soup.corners.begin() + offsets[f + 1]);
+  };
+  std::vector<char> near(soup.n_vertices(), 0), removed(soup.n_faces(), 0);
+  for (std::uint32_t v = 0; v < soup.n_vertices(); v += 400) {
+    if (near[v] || faces_of[v].size() < 5) continue;
+    const std::uint32_t f0 = faces_of[v][0];
+    const std::vector<std::uint32_t> a = vertices(f0);
+    for (std::uint32_t f1 : faces_of[v]) {
+      const std::vector<std::uint32_t> b = vertices(f1);
+      const auto shared = std::count_if(a.begin(), a.end(),
+                                        [&](std::uint32_t x) { return std::find(b.begin(), b.end(), x) != b.end(); });
+      if (shared != 1) continue;
+      removed[f0] = removed[f1] = 1;
+      // Keeps the next pinch two rings away.
+      for (std::uint32_t f : faces_of[v])
+        for (std::uint32_t x : vertices(f))
+          for (std::uint32_t g : faces_of[x])
+            for (std::uint32_t y : vertices(g)) near[y] = 1;
+      break;
+    }
+  }
+  Soup out;
+  out.positions = soup.positions;
+  for (std::uint32_t f = 0; f < soup.n_faces(); ++f)
+    if (!removed[f]) out.add_face(vertices(f));
+  return out;
+}
+
 // ---- the cases ---------------------------------------------------------------------------
 
 struct Setting {
@@ -211,6 +249,8 @@ const std::vector<Input>& inputs() {
       {"book3", false, [] { return book(3); }},
       {"book6", false, [] { return book(6); }},
       {"bunny", false, [] { return read_real("bunny.off"); }},
+      {"bunny_bowtie_holes", false, [] { return with_bowtie_holes(read_real("bunny.off")); }},
+      {"dragon_res3_bowtie_holes", false, [] { return with_bowtie_holes(read_real("dragon_res3.ply")); }},
       {"dragon_res4", false, [] { return read_real("dragon_res4.ply"); }},
       {"dragon_res3", false, [] { return read_real("dragon_res3.ply"); }},
       {"dragon_res2", true, [] { return read_real("dragon_res2.ply"); }},
@@ -268,6 +308,12 @@ TEST_P(NoNewDefects, Counts) {
       allowed_by_rule[0] = 2 * allowed_by_rule[0] + 3 * allowed_by_rule[2];
       allowed_by_rule[2] *= 4;
     }
+  }
+  if (setting.op == "fill_holes" && !setting.params.count("max_hole_edges") && before.non_manifold_edges == 0) {
+    // Every hole filled: watertight, but for faces with no neighbour (no hole to fill). Next
+    // to non-manifold edges a gap can show as the back of a face whose edges build() split
+    // off, which filling would only double (dragon_res3_bowtie_holes: 3 of 270 edges).
+    EXPECT_EQ(after.border_edges, before.lone_face_edges) << "every hole filled";
   }
   for (int k = 0; k < 4; ++k) {
     const std::size_t allowed = allowed_by_rule[k];
