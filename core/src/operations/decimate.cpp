@@ -16,6 +16,7 @@
 #include "hedge/error.h"
 #include "hedge/report.h"
 #include "parallel.h"
+#include "welded_copies.h"
 #ifdef HEDGE_DECIMATE_DEBUG
 #include <cstdio>
 
@@ -216,7 +217,10 @@ struct Candidate {
 // vertex may do with respect to seams of per-corner attributes: kOnSeam when a seam edge
 // touches it, kSeamLine when it lies inside one seam (it may slide along it), kLockedSeam
 // for seam ends, junctions and seams meeting the boundary (it stays).
-enum VertexFlag : std::uint8_t { kBoundary = 1, kOnSeam = 2, kSeamLine = 4, kLockedSeam = 8 };
+// kWeldedCopy: a vertex that build() split off another at a non-manifold spot; it stays, so
+// that the weld in extract() finds the input's surface there as it was, unless the target
+// cannot be reached otherwise.
+enum VertexFlag : std::uint8_t { kBoundary = 1, kOnSeam = 2, kSeamLine = 4, kLockedSeam = 8, kWeldedCopy = 16 };
 constexpr std::uint8_t kSeamBits = kOnSeam | kSeamLine | kLockedSeam;
 
 // Boundary edges add a plane through the edge, perpendicular to its face, so moving a
@@ -234,7 +238,7 @@ bool is_internal(const PropertyArray& a) { return a.name().starts_with("hedge:")
 class Decimator {
  public:
   Decimator(Mesh& mesh, const DecimateOptions& options, Progress& progress)
-      : m_(mesh), opt_(options), progress_(progress) {}
+      : m_(mesh), opt_(options), progress_(progress), copies_(mesh) {}
 
   DecimateReport run();
 
@@ -245,6 +249,15 @@ class Decimator {
   void compute_quadrics();
   void find_corner_channels();
   void classify_vertices();
+  //! Lets build()'s copies be collapsed from now on; false when none was locked.
+  bool unlock_copies() {
+    bool any = false;
+    for (VertexData& d : vd_) {
+      any = any || (d.flags & kWeldedCopy);
+      d.flags &= std::uint8_t(~kWeldedCopy);
+    }
+    return any;
+  }
   std::uint8_t classify(Vertex v) const;
   void fill_heap();
 
@@ -300,6 +313,7 @@ class Decimator {
     kLowValence,    // the merged vertex would have fewer than three edges
     kDoubleEdge,    // v0 and v1 are joined twice
     kLink,          // the rings share a vertex besides vl and vr
+    kWeld,          // extract()'s weld of build()'s copies would give an edge of v1 a third face
     kFold,          // a triangle would turn too far or become degenerate
     kQuality,       // the worst triangle would fall below min_quality
     kRefusals
@@ -321,6 +335,7 @@ class Decimator {
   Mesh& m_;
   const DecimateOptions& opt_;
   Progress& progress_;
+  const detail::WeldedCopies copies_;
 
   Vec3d center_{};
   double scale_ = 1, inv_scale_ = 1;
@@ -507,6 +522,7 @@ void Decimator::classify_vertices() {
           static_cast<std::uint16_t>(std::min<std::size_t>(m_.valence(v), std::numeric_limits<std::uint16_t>::max()));
       std::uint8_t f = m_.is_boundary(v) ? kBoundary : 0;
       if (seam_mode_) f |= classify(v);
+      if (copies_.is_copy(v)) f |= kWeldedCopy;
       vd_[i].flags = f;
     }
   });
@@ -565,13 +581,13 @@ bool Decimator::evaluate(Edge e, Candidate& c) const {
   }
   auto removable = [&](std::uint8_t f) {
     if (opt_.preserve_boundary && (f & kBoundary) && !boundary_edge) return false;
-    if (f & kLockedSeam) return false;
+    if (f & (kLockedSeam | kWeldedCopy)) return false;
     if (f & kSeamLine) return seam_both;
     return true;
   };
   auto movable = [&](std::uint8_t f) {
     if (opt_.preserve_boundary && (f & kBoundary)) return false;
-    if (f & kLockedSeam) return false;
+    if (f & (kLockedSeam | kWeldedCopy)) return false;
     if (f & kSeamLine) return seam_both;
     return true;
   };
@@ -783,6 +799,16 @@ Decimator::Refusal Decimator::check(Halfedge h, const Point& target) const {
     for (const RingEntry& r0 : ring0_)
       if (r0.vertex == r1.vertex) return kLink;
   }
+  // The same through the weld: v0's neighbours become v1's; one that welds with v1 would
+  // make an edge from a vertex to itself, and an edge v1 - r that other copies already make
+  // would carry a third face.
+  if (copies_.any())
+    for (const RingEntry& r0 : ring0_) {
+      const Vertex r = r0.vertex;
+      if (r == vl || r == vr || r == v1) continue;
+      if (copies_.is_copy(v1) || copies_.is_copy(r))
+        if (copies_.same(v1, r) || copies_.edge_elsewhere(m_, v1, r)) return kWeld;
+    }
   // Every triangle that stays, around either end, with its apex moved to the target. Quality
   // is judged over the whole neighbourhood (pmp's rule): a collapse may not make its worst
   // triangle worse than both the threshold and the worst triangle it replaces, so slivers of
@@ -983,7 +1009,11 @@ void Decimator::interpolate_vertex(Vertex removed, Vertex kept, const Candidate&
   interp_index_[1] = kept.idx();
   interp_weight_[0] = 1 - c.kept_weight;
   interp_weight_[1] = c.kept_weight;
+  const bool copies = copies_.is_copy(removed) || copies_.is_copy(kept);
   for (const VertexArray& a : vertex_arrays_) {
+    // Where a copy goes, the kept vertex keeps its own source: taking the copy's would weld
+    // it to the copy's other copies.
+    if (copies && !a.channel && is_internal(*a.array)) continue;
     if (a.channel && vertex_blend_size_ == 3 && a.channel->stride() <= 256) {
       // Deleted vertices keep their rows until garbage collection: the removed end's too.
       std::byte out[256];
@@ -1041,8 +1071,9 @@ void Decimator::collapse(Halfedge h, const Candidate& c) {
   if (vr.is_valid()) --vd_[vr.idx()].valence;
   faces_ -= removed_faces;
 
-  // The kept vertex is on the boundary when either end was; vl and vr keep their status.
-  d1.flags = (d0.flags | d1.flags) & kBoundary;
+  // The kept vertex is on the boundary when either end was, and a copy when it was one; vl
+  // and vr keep their status.
+  d1.flags = std::uint8_t(((d0.flags | d1.flags) & kBoundary) | (d1.flags & kWeldedCopy));
   if (seam_mode_) {
     d1.flags |= classify(v1);
     for (Vertex v : {vl, vr}) {
@@ -1102,11 +1133,17 @@ DecimateReport Decimator::run() {
       // Edges refused earlier (fold-overs, link condition) may be legal now that their
       // neighbourhood changed: queue every edge again while that still helps. Past the
       // preferred limit on turning triangles, only flips stay forbidden.
-      if (faces_ == target_ + 1 && skipped_for_parity_) break;
-      if (cos_max_normal_change_ > 0) {
+      if (faces_ == target_ + 1 && skipped_for_parity_) {
+        // Only a boundary collapse fits, and on a non-manifold input the boundary may be
+        // all copies.
+        if (!unlock_copies()) break;
+      } else if (cos_max_normal_change_ > 0) {
         cos_max_normal_change_ = 0;
       } else if (collapses_since_fill == 0 || ++refills > 4) {
-        break;
+        // Short of the target: build()'s copies may go too, as the last resort (extract()
+        // keeps apart those whose weld would then add a defect).
+        if (!unlock_copies()) break;
+        refills = 0;
       }
       collapses_since_fill = 0;
       for (Edge e : m_.edges()) requeue(e);

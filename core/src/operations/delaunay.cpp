@@ -10,6 +10,7 @@
 
 #include "hedge/error.h"
 #include "hedge/normals.h"
+#include "welded_copies.h"
 
 namespace hedge {
 namespace {
@@ -77,13 +78,18 @@ struct Seams {
 
 enum class Verdict { delaunay, flip, feature, seam, blocked, fold };
 
-Verdict judge(const Mesh& m, Edge e, const DelaunayOptions& o, const Seams& seams) {
+Verdict judge(const Mesh& m, Edge e, const DelaunayOptions& o, const Seams& seams, const detail::WeldedCopies& copies) {
   const Quad q = quad_of(m, e);
   if (angle_at(q.c, q.u, q.w) + angle_at(q.d, q.u, q.w) <= std::numbers::pi + o.angle_epsilon) return Verdict::delaunay;
   const Vec3d n0 = normal(q.u, q.w, q.c), n1 = normal(q.w, q.u, q.d);
   if (degrees_between(n0, n1) > o.feature_angle) return Verdict::feature;
   if (seams.at(m, q)) return Verdict::seam;
   if (!m.is_flip_ok(e)) return Verdict::blocked;
+  // Where build() split the surface, the weld must not meet the flip: the old edge is one
+  // with another (a split non-manifold edge), or the new one is there already.
+  if (copies.any() && (copies.edge_elsewhere(m, m.to_vertex(q.h1), m.to_vertex(q.h0), e) ||
+                       copies.edge_elsewhere(m, m.to_vertex(m.next(q.h0)), m.to_vertex(m.next(q.h1)))))
+    return Verdict::blocked;
   // The new triangles (u, d, c) and (d, w, c) must not make a feature of the new edge, nor
   // face against the old pair, nor vanish.
   const Vec3d m0 = normal(q.u, q.d, q.c), m1 = normal(q.d, q.w, q.c);
@@ -113,10 +119,11 @@ double dihedral_angle_degrees(const Mesh& mesh, Edge e) {
 DelaunayCensus delaunay_census(const Mesh& mesh, const DelaunayOptions& options) {
   DelaunayCensus c;
   const Seams seams(mesh);
+  const detail::WeldedCopies copies(mesh);
   for (Edge e : mesh.edges()) {
     if (!is_interior_triangle_edge(mesh, e)) continue;
     ++c.interior_edges;
-    const Verdict v = judge(mesh, e, options, seams);
+    const Verdict v = judge(mesh, e, options, seams, copies);
     if (v == Verdict::delaunay) continue;
     ++c.non_delaunay;
     switch (v) {
@@ -154,6 +161,7 @@ DelaunayReport make_delaunay(Mesh& mesh, const DelaunayOptions& options, Progres
   Mesh work = mesh;  // flips happen on a copy, so a cancellation leaves the input as it was
   report.before = delaunay_census(work, options);
   const Seams seams(work);
+  const detail::WeldedCopies copies(work);
 
   std::vector<Index> stack;
   std::vector<char> queued(work.edges_size(), 0);
@@ -170,7 +178,7 @@ DelaunayReport make_delaunay(Mesh& mesh, const DelaunayOptions& options, Progres
     queued[e.idx()] = 0;
     if ((++pops & 0xffff) == 0)
       progress.update(0.05 + 0.9 * double(pops) / double(pops + stack.size()), "flipping edges");
-    if (judge(work, e, options, seams) != Verdict::flip) continue;
+    if (judge(work, e, options, seams, copies) != Verdict::flip) continue;
     if (double(report.flips) >= budget) {
       report.budget_exhausted = true;
       break;
