@@ -45,4 +45,35 @@ bool WeldedCopies::edge_elsewhere(const Mesh& mesh, Vertex u, Vertex v, Edge exc
   return false;
 }
 
+bool WeldedCopies::meets_flip(const Mesh& mesh, Edge e) const {
+  if (!any()) return false;
+  const Halfedge h0 = Mesh::halfedge(e, 0), h1 = Mesh::halfedge(e, 1);
+  const Vertex c = mesh.to_vertex(mesh.next(h0)), d = mesh.to_vertex(mesh.next(h1));
+  return edge_elsewhere(mesh, mesh.to_vertex(h0), mesh.to_vertex(h1), e) || same(c, d) || edge_elsewhere(mesh, c, d);
+}
+
+bool WeldedCopies::meets_collapse(const Mesh& mesh, Halfedge h) const {
+  if (!any()) return false;
+  const Vertex v0 = mesh.from_vertex(h), v1 = mesh.to_vertex(h);
+  const Halfedge o = Mesh::opposite(h);
+  const Vertex vl = mesh.is_boundary(h) ? Vertex() : mesh.to_vertex(mesh.next(h));
+  const Vertex vr = mesh.is_boundary(o) ? Vertex() : mesh.to_vertex(mesh.next(o));
+  for (Halfedge g : mesh.outgoing(v0)) {
+    const Vertex r = mesh.to_vertex(g);
+    if (!is_copy(v0) && !is_copy(r) && !is_copy(v1)) continue;
+    // The removed end's edges that the weld shares with other copies would move to v1.
+    if (edge_elsewhere(mesh, v0, r, Mesh::edge(g))) return true;
+    if (r == v1) continue;
+    // vl and vr keep their edge to v1; the weld must not make it one with another, or the
+    // triangle v0 leaves on them (when v0 has three neighbours) may weld onto an existing one.
+    if (r == vl || r == vr) {
+      const Edge kept = Mesh::edge(r == vl ? mesh.next(h) : mesh.prev(o));
+      if (edge_elsewhere(mesh, v1, r, kept)) return true;
+      continue;
+    }
+    if (same(v1, r) || edge_elsewhere(mesh, v1, r)) return true;
+  }
+  return false;
+}
+
 }  // namespace hedge::detail

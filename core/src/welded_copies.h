@@ -26,6 +26,14 @@ class WeldedCopies {
   }
   //! Whether, after the weld, u - v is an edge through a mesh edge other than `except`.
   bool edge_elsewhere(const Mesh& mesh, Vertex u, Vertex v, Edge except = Edge()) const;
+  //! Whether the weld meets a flip of interior edge e: e is one edge with another (a split
+  //! non-manifold edge), or the new diagonal is there already or joins a vertex to itself.
+  bool meets_flip(const Mesh& mesh, Edge e) const;
+  //! Whether the weld meets the collapse of h (from_vertex into to_vertex): the removed end
+  //! is on an edge the weld shares with other copies (a split non-manifold edge, which would
+  //! move), or has a neighbour that welds with the kept end (an edge from a vertex to itself)
+  //! or whose edge to the kept end other copies already make (a third face on it).
+  bool meets_collapse(const Mesh& mesh, Halfedge h) const;
 
  private:
   static constexpr std::uint32_t kNone = ~std::uint32_t(0);

@@ -217,10 +217,7 @@ struct Candidate {
 // vertex may do with respect to seams of per-corner attributes: kOnSeam when a seam edge
 // touches it, kSeamLine when it lies inside one seam (it may slide along it), kLockedSeam
 // for seam ends, junctions and seams meeting the boundary (it stays).
-// kWeldedCopy: a vertex that build() split off another at a non-manifold spot; it stays, so
-// that the weld in extract() finds the input's surface there as it was, unless the target
-// cannot be reached otherwise.
-enum VertexFlag : std::uint8_t { kBoundary = 1, kOnSeam = 2, kSeamLine = 4, kLockedSeam = 8, kWeldedCopy = 16 };
+enum VertexFlag : std::uint8_t { kBoundary = 1, kOnSeam = 2, kSeamLine = 4, kLockedSeam = 8 };
 constexpr std::uint8_t kSeamBits = kOnSeam | kSeamLine | kLockedSeam;
 
 // Boundary edges add a plane through the edge, perpendicular to its face, so moving a
@@ -249,14 +246,12 @@ class Decimator {
   void compute_quadrics();
   void find_corner_channels();
   void classify_vertices();
-  //! Lets build()'s copies be collapsed from now on; false when none was locked.
-  bool unlock_copies() {
-    bool any = false;
-    for (VertexData& d : vd_) {
-      any = any || (d.flags & kWeldedCopy);
-      d.flags &= std::uint8_t(~kWeldedCopy);
-    }
-    return any;
+  //! Lets collapses meet extract()'s weld of build()'s copies from now on; false when they
+  //! could already (or there are no copies).
+  bool relax_weld() {
+    if (!copies_.any() || weld_relaxed_) return false;
+    weld_relaxed_ = true;
+    return true;
   }
   std::uint8_t classify(Vertex v) const;
   void fill_heap();
@@ -336,6 +331,7 @@ class Decimator {
   const DecimateOptions& opt_;
   Progress& progress_;
   const detail::WeldedCopies copies_;
+  bool weld_relaxed_ = false;  // the last resort: collapses may meet the weld
 
   Vec3d center_{};
   double scale_ = 1, inv_scale_ = 1;
@@ -522,7 +518,6 @@ void Decimator::classify_vertices() {
           static_cast<std::uint16_t>(std::min<std::size_t>(m_.valence(v), std::numeric_limits<std::uint16_t>::max()));
       std::uint8_t f = m_.is_boundary(v) ? kBoundary : 0;
       if (seam_mode_) f |= classify(v);
-      if (copies_.is_copy(v)) f |= kWeldedCopy;
       vd_[i].flags = f;
     }
   });
@@ -581,13 +576,13 @@ bool Decimator::evaluate(Edge e, Candidate& c) const {
   }
   auto removable = [&](std::uint8_t f) {
     if (opt_.preserve_boundary && (f & kBoundary) && !boundary_edge) return false;
-    if (f & (kLockedSeam | kWeldedCopy)) return false;
+    if (f & kLockedSeam) return false;
     if (f & kSeamLine) return seam_both;
     return true;
   };
   auto movable = [&](std::uint8_t f) {
     if (opt_.preserve_boundary && (f & kBoundary)) return false;
-    if (f & (kLockedSeam | kWeldedCopy)) return false;
+    if (f & kLockedSeam) return false;
     if (f & kSeamLine) return seam_both;
     return true;
   };
@@ -799,16 +794,8 @@ Decimator::Refusal Decimator::check(Halfedge h, const Point& target) const {
     for (const RingEntry& r0 : ring0_)
       if (r0.vertex == r1.vertex) return kLink;
   }
-  // The same through the weld: v0's neighbours become v1's; one that welds with v1 would
-  // make an edge from a vertex to itself, and an edge v1 - r that other copies already make
-  // would carry a third face.
-  if (copies_.any())
-    for (const RingEntry& r0 : ring0_) {
-      const Vertex r = r0.vertex;
-      if (r == vl || r == vr || r == v1) continue;
-      if (copies_.is_copy(v1) || copies_.is_copy(r))
-        if (copies_.same(v1, r) || copies_.edge_elsewhere(m_, v1, r)) return kWeld;
-    }
+  // The same through extract()'s weld of build()'s copies.
+  if (!weld_relaxed_ && copies_.meets_collapse(m_, h)) return kWeld;
   // Every triangle that stays, around either end, with its apex moved to the target. Quality
   // is judged over the whole neighbourhood (pmp's rule): a collapse may not make its worst
   // triangle worse than both the threshold and the worst triangle it replaces, so slivers of
@@ -1071,9 +1058,8 @@ void Decimator::collapse(Halfedge h, const Candidate& c) {
   if (vr.is_valid()) --vd_[vr.idx()].valence;
   faces_ -= removed_faces;
 
-  // The kept vertex is on the boundary when either end was, and a copy when it was one; vl
-  // and vr keep their status.
-  d1.flags = std::uint8_t(((d0.flags | d1.flags) & kBoundary) | (d1.flags & kWeldedCopy));
+  // The kept vertex is on the boundary when either end was; vl and vr keep their status.
+  d1.flags = (d0.flags | d1.flags) & kBoundary;
   if (seam_mode_) {
     d1.flags |= classify(v1);
     for (Vertex v : {vl, vr}) {
@@ -1135,14 +1121,14 @@ DecimateReport Decimator::run() {
       // preferred limit on turning triangles, only flips stay forbidden.
       if (faces_ == target_ + 1 && skipped_for_parity_) {
         // Only a boundary collapse fits, and on a non-manifold input the boundary may be
-        // all copies.
-        if (!unlock_copies()) break;
+        // all split non-manifold edges, which the weld guards.
+        if (!relax_weld()) break;
       } else if (cos_max_normal_change_ > 0) {
         cos_max_normal_change_ = 0;
       } else if (collapses_since_fill == 0 || ++refills > 4) {
-        // Short of the target: build()'s copies may go too, as the last resort (extract()
-        // keeps apart those whose weld would then add a defect).
-        if (!unlock_copies()) break;
+        // Short of the target: collapses may meet the weld of build()'s copies too, as the
+        // last resort (extract() keeps apart the copies whose weld would then add a defect).
+        if (!relax_weld()) break;
         refills = 0;
       }
       collapses_since_fill = 0;

@@ -85,11 +85,7 @@ Verdict judge(const Mesh& m, Edge e, const DelaunayOptions& o, const Seams& seam
   if (degrees_between(n0, n1) > o.feature_angle) return Verdict::feature;
   if (seams.at(m, q)) return Verdict::seam;
   if (!m.is_flip_ok(e)) return Verdict::blocked;
-  // Where build() split the surface, the weld must not meet the flip: the old edge is one
-  // with another (a split non-manifold edge), or the new one is there already.
-  if (copies.any() && (copies.edge_elsewhere(m, m.to_vertex(q.h1), m.to_vertex(q.h0), e) ||
-                       copies.edge_elsewhere(m, m.to_vertex(m.next(q.h0)), m.to_vertex(m.next(q.h1)))))
-    return Verdict::blocked;
+  if (copies.meets_flip(m, e)) return Verdict::blocked;
   // The new triangles (u, d, c) and (d, w, c) must not make a feature of the new edge, nor
   // face against the old pair, nor vanish.
   const Vec3d m0 = normal(q.u, q.d, q.c), m1 = normal(q.d, q.w, q.c);

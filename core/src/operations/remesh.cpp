@@ -15,6 +15,7 @@
 #include "hedge/error.h"
 #include "hedge/report.h"
 #include "parallel.h"
+#include "welded_copies.h"
 
 namespace hedge {
 namespace {
@@ -114,7 +115,7 @@ void blend_channel(const ChannelArray& src, const Index from[3], const double w[
 class Remesher {
  public:
   Remesher(Mesh& mesh, const Mesh& input, const RemeshOptions& options, Progress& progress)
-      : mesh_(mesh), input_(input), options_(options), progress_(progress) {}
+      : mesh_(mesh), input_(input), options_(options), progress_(progress), copies_(mesh) {}
 
   RemeshReport run();
 
@@ -144,6 +145,7 @@ class Remesher {
   }
   bool star_ok(Vertex v, Vertex other, const Vec3d& target) const;
   bool may_collapse(Halfedge h, const Vec3d& target) const;
+  bool makes_twin_triangle(Halfedge h) const;
   bool flip_if_better(Edge e);
   void grow_vertex_arrays();
 
@@ -155,6 +157,7 @@ class Remesher {
   const Mesh& input_;
   const RemeshOptions& options_;
   Progress& progress_;
+  const detail::WeldedCopies copies_;  // build()'s copies: no flip, split or collapse may meet their weld
   RemeshReport report_;
   double length_ = 0;  // the target edge length L
 
@@ -386,8 +389,12 @@ void Remesher::split_long_edges() {
       Vertex c = mesh_.is_boundary(h0) ? Vertex() : mesh_.to_vertex(mesh_.next(h0));
       Vertex d = mesh_.is_boundary(h1) ? Vertex() : mesh_.to_vertex(mesh_.next(h1));
       // Two triangles on the same third corner (a pillow, left by build() at non-manifold
-      // spots) cannot be split: the new vertex would be joined to that corner twice.
-      if (c.is_valid() && c == d) continue;
+      // spots) cannot be split: the new vertex would be joined to that corner twice. The
+      // same holds for two copies of one corner, which the weld makes one; and an edge the
+      // weld makes one with another (a split non-manifold edge) would have the new vertex on
+      // one copy only.
+      if (c.is_valid() && d.is_valid() && copies_.same(c, d)) continue;
+      if (copies_.any() && copies_.edge_elsewhere(mesh_, a, b, e)) continue;
 
       Vertex v = mesh_.add_vertex(to_float((to_double(mesh_.position(a)) + to_double(mesh_.position(b))) * 0.5));
       const Index from[2] = {a.idx(), b.idx()};
@@ -437,6 +444,25 @@ bool Remesher::star_ok(Vertex v, Vertex other, const Vec3d& target) const {
   return true;
 }
 
+// Whether collapsing h would give a triangle of from_vertex(h) the corners of one that
+// to_vertex(h) has already: a second face on the same three vertices. Mesh::is_collapse_ok()
+// catches this around the edge's own triangles; near build()'s split non-manifold edges it
+// can happen one ring further out.
+bool Remesher::makes_twin_triangle(Halfedge h) const {
+  const Vertex v0 = mesh_.from_vertex(h), v1 = mesh_.to_vertex(h);
+  for (Halfedge g : mesh_.outgoing(v0)) {
+    if (mesh_.is_boundary(g)) continue;
+    const Vertex x = mesh_.to_vertex(g), y = mesh_.to_vertex(mesh_.next(g));
+    if (x == v1 || y == v1) continue;
+    for (Halfedge k : mesh_.outgoing(v1)) {
+      if (mesh_.is_boundary(k)) continue;
+      const Vertex a = mesh_.to_vertex(k), b = mesh_.to_vertex(mesh_.next(k));
+      if ((a == x && b == y) || (a == y && b == x)) return true;
+    }
+  }
+  return false;
+}
+
 // Whether from_vertex(h) may be removed by collapsing h, the kept vertex going to `target`.
 bool Remesher::may_collapse(Halfedge h, const Vec3d& target) const {
   const Vertex v0 = mesh_.from_vertex(h), v1 = mesh_.to_vertex(h);
@@ -451,7 +477,7 @@ bool Remesher::may_collapse(Halfedge h, const Vec3d& target) const {
   if (k0 == Kind::sliding && !(edge_flags_[Mesh::edge(h).idx()] & kCurve)) return false;
   if (!star_ok(v0, v1, target)) return false;
   if (!(target == to_double(mesh_.position(v1))) && !star_ok(v1, v0, target)) return false;
-  return mesh_.is_collapse_ok(h);
+  return mesh_.is_collapse_ok(h) && !copies_.meets_collapse(mesh_, h) && !makes_twin_triangle(h);
 }
 
 // One pass over all edges, then the edges at each vertex a collapse moved, until none is
@@ -574,7 +600,7 @@ bool Remesher::flip_if_better(Edge e) {
   if (new_min < kFlipMinAngleDegrees &&
       new_min < std::min(triangle_min_angle(pb, pa, pc), triangle_min_angle(pa, pb, pd)))
     return false;
-  if (!mesh_.is_flip_ok(e)) return false;
+  if (!mesh_.is_flip_ok(e) || copies_.meets_flip(mesh_, e)) return false;
   mesh_.flip(e);
   --da.valence, --db.valence, ++dc.valence, ++dd.valence;
   ++report_.flips;
@@ -625,7 +651,7 @@ bool Remesher::open_cap(Edge e) {
   if (!(dot(n1, n2) > 0 && dot(n1, old_normal) > 0 && dot(n2, old_normal) > 0)) return false;
   const double before = std::min(triangle_min_angle(pb, pa, pc), triangle_min_angle(pa, pb, pd));
   const double after = std::min(triangle_min_angle(pa, pc, pd), triangle_min_angle(pc, pb, pd));
-  if (!(after > before) || !mesh_.is_flip_ok(e)) return false;
+  if (!(after > before) || !mesh_.is_flip_ok(e) || copies_.meets_flip(mesh_, e)) return false;
   mesh_.flip(e);
   --degree_[a.idx()].valence, --degree_[b.idx()].valence, ++degree_[c.idx()].valence, ++degree_[d.idx()].valence;
   ++report_.flips;

@@ -20,6 +20,7 @@
 #include "hedge/normals.h"
 #include "hedge/topology.h"
 #include "parallel.h"
+#include "welded_copies.h"
 
 namespace hedge {
 namespace {
@@ -688,6 +689,16 @@ Mesh sqrt3_step(const Mesh& m, bool trisect, std::vector<bool>& crease, unsigned
     return Halfedge(2 * (crease_edge0 + 6 * c + which) + side);
   };
   auto is_crease = [&](Edge e) { return creases && crease[e.idx()]; };
+  // An interior edge that extract()'s weld makes one with another (a split non-manifold
+  // edge) is not flipped either, nor cut: flipping one copy would leave the others' faces
+  // on an edge that no longer exists, and its ends with fans that no longer meet.
+  std::vector<bool> welded;
+  if (const detail::WeldedCopies copies(m); copies.any()) {
+    welded.assign(E, false);
+    for (Edge e : m.edges())
+      welded[e.idx()] = !m.is_boundary(e) && copies.edge_elsewhere(m, m.vertex(e, 0), m.vertex(e, 1), e);
+  }
+  auto is_welded = [&](Edge e) { return !welded.empty() && welded[e.idx()]; };
   // is_cut(g): g's edge is a boundary edge cut on this step. boundary_out(g), for a boundary
   // half-edge g: the half-edge that then leaves g's origin B along the boundary (B -> Q2), g
   // itself when its edge is not cut.
@@ -774,7 +785,7 @@ Mesh sqrt3_step(const Mesh& m, bool trisect, std::vector<bool>& crease, unsigned
         const Halfedge g = Mesh::opposite(h);
         const Edge e = Mesh::edge(h);
         const Halfedge a = spoke(f, i, 1);
-        const bool boundary = m.is_boundary(g), sharp = boundary || is_crease(e);
+        const bool boundary = m.is_boundary(g), sharp = boundary || is_crease(e) || is_welded(e);
         if (boundary && is_cut(g)) {
           const Index k = boundary_number[e.idx()];
           const Vertex q1(V + F + 2 * k), q2(V + F + 2 * k + 1);
