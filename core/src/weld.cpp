@@ -57,6 +57,7 @@ struct Defects {
   };
   std::vector<Fans> nm_vertices;
   std::vector<std::vector<std::uint32_t>> duplicates;  // faces sharing one key set, ascending
+  std::vector<std::vector<std::uint32_t>> repeating;   // faces listing a key twice, by key set
 };
 
 Defects find_defects(const Faces& faces) {
@@ -121,20 +122,29 @@ Defects find_defects(const Faces& faces) {
     i = j;
   }
 
-  // Duplicates: faces with a watched vertex and one key set.
-  std::vector<std::pair<std::vector<Key>, std::uint32_t>> sets;
+  // Duplicates: faces with a watched vertex and one key set. Faces repeating a key (only a
+  // weld can: a watched one), grouped the same way.
+  std::vector<std::pair<std::vector<Key>, std::uint32_t>> sets, repeats;
   for (std::uint32_t f = 0; f < faces.size(); ++f)
-    if (faces.any_watched(f)) sets.emplace_back(faces.key_set(f), f);
-  std::sort(sets.begin(), sets.end());
-  for (std::size_t i = 0; i < sets.size();) {
-    std::size_t j = i + 1;
-    while (j < sets.size() && sets[j].first == sets[i].first) ++j;
-    if (j - i > 1) {
-      d.duplicates.emplace_back();
-      for (std::size_t k = i; k < j; ++k) d.duplicates.back().push_back(sets[k].second);
+    if (faces.any_watched(f)) {
+      sets.emplace_back(faces.key_set(f), f);
+      if (sets.back().first.size() < faces.start[f + 1] - faces.start[f]) repeats.push_back(sets.back());
     }
-    i = j;
-  }
+  auto group = [](std::vector<std::pair<std::vector<Key>, std::uint32_t>>& by_set, std::size_t min,
+                  std::vector<std::vector<std::uint32_t>>& groups) {
+    std::sort(by_set.begin(), by_set.end());
+    for (std::size_t i = 0; i < by_set.size();) {
+      std::size_t j = i + 1;
+      while (j < by_set.size() && by_set[j].first == by_set[i].first) ++j;
+      if (j - i >= min) {
+        groups.emplace_back();
+        for (std::size_t k = i; k < j; ++k) groups.back().push_back(by_set[k].second);
+      }
+      i = j;
+    }
+  };
+  group(sets, 2, d.duplicates);
+  group(repeats, 1, d.repeating);
   return d;
 }
 
@@ -142,20 +152,29 @@ Defects find_defects(const Faces& faces) {
 struct Baseline {
   std::vector<std::pair<Key, Key>> nm_edges;
   std::vector<Key> nm_vertices;
-  std::vector<std::vector<Key>> duplicates;
+  std::vector<std::pair<std::vector<Key>, std::size_t>> duplicates, repeating;  // (key set, faces with it)
 
   explicit Baseline(const Faces& faces) {
     const Defects d = find_defects(faces);
     for (auto [i, j] : d.nm_edges) nm_edges.emplace_back(d.sides[i].lo, d.sides[i].hi);
     for (const auto& fans : d.nm_vertices) nm_vertices.push_back(fans.key);
-    for (const auto& group : d.duplicates) duplicates.push_back(faces.key_set(group[0]));
+    for (const auto& group : d.duplicates) duplicates.emplace_back(faces.key_set(group[0]), group.size());
+    for (const auto& group : d.repeating) repeating.emplace_back(faces.key_set(group[0]), group.size());
     std::sort(nm_edges.begin(), nm_edges.end());
     std::sort(nm_vertices.begin(), nm_vertices.end());
     std::sort(duplicates.begin(), duplicates.end());
+    std::sort(repeating.begin(), repeating.end());
   }
   template <class T>
   static bool has(const std::vector<T>& sorted, const T& value) {
     return std::binary_search(sorted.begin(), sorted.end(), value);
+  }
+  //! How many faces of `groups` (duplicates or repeating) the input has with this key set.
+  static std::size_t faces_with(const std::vector<std::pair<std::vector<Key>, std::size_t>>& groups,
+                                const std::vector<Key>& set, std::size_t otherwise) {
+    auto it = std::lower_bound(groups.begin(), groups.end(), set,
+                               [](const auto& entry, const std::vector<Key>& s) { return entry.first < s; });
+    return it != groups.end() && it->first == set ? it->second : otherwise;
   }
 };
 
@@ -188,11 +207,18 @@ class Guard {
       }
       for (const auto& fans : found.nm_vertices)
         if (!Baseline::has(baseline.nm_vertices, fans.key)) moved += split_fans(faces, fans);
+      // A key set the input had on several faces may come back on as many, no more.
       for (const auto& group : found.duplicates) {
         const std::vector<Key> set = faces.key_set(group[0]);
-        if (std::all_of(set.begin(), set.end(), [&](Key k) { return ours(k); }) &&
-            !Baseline::has(baseline.duplicates, set))
-          moved += split_duplicate(faces, group);
+        const std::size_t keep = Baseline::faces_with(baseline.duplicates, set, 1);
+        if (std::all_of(set.begin(), set.end(), [&](Key k) { return ours(k); }) && group.size() > keep)
+          moved += split_duplicate(faces, group, keep);
+      }
+      // Faces repeating a vertex, as often as the input had their key set (an Euler edit or
+      // an operation can cut a face build() let repeat its vertex into pieces that repeat it).
+      for (const auto& group : found.repeating) {
+        const std::size_t keep = Baseline::faces_with(baseline.repeating, faces.key_set(group[0]), 0);
+        for (std::size_t k = keep; k < group.size(); ++k) moved += split_repeat(faces, group[k]);
       }
       if (moved == before) return moved;
     }
@@ -341,21 +367,59 @@ class Guard {
     return moved;
   }
 
-  //! Faces made one by the weld: every face after the first moves one of its copies.
-  std::size_t split_duplicate(const Faces& faces, const std::vector<std::uint32_t>& group) {
-    std::vector<std::uint32_t> all(faces.mesh_vertex.begin() + faces.start[group[0]],
-                                   faces.mesh_vertex.begin() + faces.start[group[0] + 1]);
+  //! Faces made one by the weld: all but `keep` of them move a copy, one that the faces kept
+  //! do not use where there is one. Faces none of whose copies may move are kept first.
+  std::size_t split_duplicate(const Faces& faces, const std::vector<std::uint32_t>& group, std::size_t keep) {
+    std::vector<std::uint32_t> all;
     for (std::uint32_t f : group)
       all.insert(all.end(), faces.mesh_vertex.begin() + faces.start[f], faces.mesh_vertex.begin() + faces.start[f + 1]);
     if (stale(all)) return 0;
+    std::vector<std::uint32_t> used;  // mesh vertices of the faces kept
+    auto copy_to_move = [&](std::uint32_t f) -> std::uint32_t {
+      std::uint32_t any = ~0u;
+      for (std::uint32_t c = faces.start[f]; c < faces.start[f + 1]; ++c) {
+        const std::uint32_t v = faces.mesh_vertex[c];
+        if (!faces.watched[c] || !movable(v)) continue;
+        if (std::find(used.begin(), used.end(), v) == used.end()) return v;
+        if (any == ~0u) any = v;
+      }
+      return any;
+    };
+    std::vector<std::uint32_t> ranked;
+    for (std::uint32_t f : group)
+      if (copy_to_move(f) == ~0u) ranked.push_back(f);
+    for (std::uint32_t f : group)
+      if (copy_to_move(f) != ~0u) ranked.push_back(f);
     std::size_t moved = 0;
-    for (std::size_t k = 1; k < group.size(); ++k) {
-      const std::uint32_t f = group[k];
-      for (std::uint32_t c = faces.start[f]; c < faces.start[f + 1]; ++c)
-        if (faces.watched[c] && movable(faces.mesh_vertex[c])) {
-          moved += move(faces.mesh_vertex[c]);
-          break;
-        }
+    for (std::size_t k = 0; k < ranked.size(); ++k) {
+      const std::uint32_t f = ranked[k];
+      if (k < keep) {
+        used.insert(used.end(), faces.mesh_vertex.begin() + faces.start[f],
+                    faces.mesh_vertex.begin() + faces.start[f + 1]);
+      } else if (const std::uint32_t v = copy_to_move(f); v != ~0u) {
+        moved += move(v);
+      }
+    }
+    return moved;
+  }
+
+  //! A face listing a key twice or more: per key, the representative's copy (or the first)
+  //! stays and the others move.
+  std::size_t split_repeat(const Faces& faces, std::uint32_t f) {
+    std::vector<std::pair<Key, std::uint32_t>> corners;  // (key, mesh vertex)
+    for (std::uint32_t c = faces.start[f]; c < faces.start[f + 1]; ++c)
+      corners.emplace_back(faces.keys[c], faces.mesh_vertex[c]);
+    if (std::any_of(corners.begin(), corners.end(), [&](const auto& kv) { return moved_flag_[kv.second]; })) return 0;
+    std::sort(corners.begin(), corners.end());
+    std::size_t moved = 0;
+    for (std::size_t i = 0; i < corners.size();) {
+      std::size_t j = i + 1, keep = i;
+      while (j < corners.size() && corners[j].first == corners[i].first) ++j;
+      for (std::size_t k = i; k < j; ++k)
+        if (representative(corners[k].second)) keep = k;
+      for (std::size_t k = i; k < j; ++k)
+        if (k != keep && movable(corners[k].second)) moved += move(corners[k].second);
+      i = j;
     }
     return moved;
   }

@@ -1,7 +1,8 @@
 // libFuzzer target: build() on a soup drawn from the input (positions with the odd NaN or
 // infinity, polygons of any size, indices mostly in range, channels of all three domains).
 // hedge::Error is an answer; a crash, another exception or a broken mesh is a bug. When
-// build() accepts the soup, extract() must give it back bit for bit, bar skipped faces.
+// build() accepts the soup, extract() must give it back bit for bit, bar skipped faces, with
+// and without the input to guard its weld (ExtractOptions::input).
 #include <fuzzer/FuzzedDataProvider.h>
 
 #include <cmath>
@@ -71,6 +72,6 @@ hedge::Soup draw_soup(FuzzedDataProvider& in) {
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   FuzzedDataProvider in(data, size);
   hedge::Soup soup = draw_soup(in);
-  hedge_fuzz::check_build_round_trip(soup);
+  hedge_fuzz::check_build_round_trip(soup, /*with_input=*/true);
   return 0;
 }

@@ -1,13 +1,16 @@
 // Shared checks of the fuzz targets: build a soup, validate, and compare extract() with
-// what the soup should come back as (skipped faces removed, channels grouped by domain).
+// what the soup should come back as (skipped faces removed, channels grouped by domain);
+// count the defects extract()'s weld may not add (docs/architecture.md, "No mesh comes back
+// worse") with the test suite's counter, which shares no code with the mesh.
 #pragma once
 #include <algorithm>
-#include <cstring>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <string>
 #include <vector>
 
+#include "../core/defect_counts.h"
 #include "hedge/build.h"
 #include "hedge/error.h"
 #include "hedge/soup.h"
@@ -76,9 +79,29 @@ inline std::string describe_difference(const hedge::Soup& a, const hedge::Soup& 
 //! Bitwise soup equality (operator== on float positions treats NaN as unequal and -0 == 0).
 inline bool same_bits(const hedge::Soup& a, const hedge::Soup& b) { return describe_difference(a, b).empty(); }
 
+//! Given the soup build() was given and no change since, extract() has nothing to keep apart:
+//! the same soup comes back as without it (`expected`: expected_round_trip()).
+inline void check_extract_with_input(const hedge::BuildResult& built, const hedge::Soup& soup,
+                                     const hedge::Soup& expected) {
+  hedge::ExtractOptions options;
+  options.input = &soup;
+  hedge::ExtractReport report;
+  hedge::Soup back;
+  try {
+    back = hedge::extract(built.mesh, options, &report);
+  } catch (const hedge::Error& e) {
+    fail(std::string("extract(input) threw: ") + e.what());
+  }
+  std::string diff = describe_difference(back, expected);
+  if (!diff.empty())
+    fail("extract(build(soup), input = soup) differs from the soup: " + diff + " (" +
+         std::to_string(report.copies_kept_apart) + " copies kept apart)");
+}
+
 //! build() -> validate() -> extract() round trip. hedge::Error from build() is an answer,
-//! not a bug; everything else aborts with a message.
-inline void check_build_round_trip(const hedge::Soup& soup) {
+//! not a bug; everything else aborts with a message. `with_input`: extract() given the soup
+//! must give it back too.
+inline void check_build_round_trip(const hedge::Soup& soup, bool with_input = false) {
   hedge::BuildResult built;
   try {
     built = hedge::build(soup);
@@ -100,6 +123,13 @@ inline void check_build_round_trip(const hedge::Soup& soup) {
   hedge::Soup expected = expected_round_trip(soup, built.maps.skipped_faces);
   std::string diff = describe_difference(back, expected);
   if (!diff.empty()) fail("extract(build(soup)) differs from the soup: " + diff);
+  if (with_input) check_extract_with_input(built, soup, expected);
+}
+
+inline std::string describe(const hedge::test::DefectCounts& d) {
+  return std::to_string(d.non_manifold_edges) + " non-manifold edges, " + std::to_string(d.non_manifold_vertices) +
+         " non-manifold vertices, " + std::to_string(d.duplicate_faces) + " duplicate faces, " +
+         std::to_string(d.repeating_faces) + " faces repeating a vertex";
 }
 
 }  // namespace hedge_fuzz

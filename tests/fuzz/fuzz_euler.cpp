@@ -1,17 +1,22 @@
-// libFuzzer target: a small mesh (fixed shapes or a few fuzz-chosen faces), then a
-// fuzz-driven sequence of Euler operations, each guarded by its is_*_ok test, and catalogue
-// operations with in-range parameters; validate() after every step.
+// libFuzzer target: a small mesh (fixed shapes or a few fuzz-chosen faces, with faces glued
+// on to make non-manifold edges and vertices and duplicate faces), then a fuzz-driven
+// sequence of Euler operations, each guarded by its is_*_ok test, and catalogue operations
+// with in-range parameters. After every step: validate(), and extract() given the soup the
+// mesh was built from must keep the rule "no mesh comes back worse" (DefectRule).
 #include <fuzzer/FuzzedDataProvider.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
+#include <cstdlib>
 #include <map>
 #include <string>
 #include <vector>
 
 #include "fuzz_common.h"
+#include "hedge/build.h"
 #include "hedge/catalogue.h"
 #include "hedge/mesh.h"
 #include "hedge/report.h"
@@ -23,6 +28,7 @@ using hedge::Face;
 using hedge::Halfedge;
 using hedge::Mesh;
 using hedge::Vertex;
+using hedge::test::DefectCounts;
 
 constexpr std::size_t max_faces = 160;  // keeps every run well under a millisecond or two
 
@@ -83,9 +89,157 @@ hedge::Soup random_faces(FuzzedDataProvider& in) {
   return s;
 }
 
-void check(const Mesh& mesh, const char* after) {
+//! Glues `n` faces onto the soup where they make defects, so that build() makes copies for
+//! extract() to weld back: a fin on a face's side (a third face on an edge), a triangle at a
+//! corner on new vertices (a bow-tie vertex), a face listed again (reversed or turned), a
+//! triangle over a side and another vertex of the soup.
+void add_defects(FuzzedDataProvider& in, hedge::Soup& s, int n) {
+  for (int k = 0; k < n && s.n_faces() > 0; ++k) {
+    const std::vector<std::size_t> offsets = s.face_offsets();
+    const std::size_t f = in.ConsumeIntegralInRange<std::size_t>(0, s.n_faces() - 1);
+    std::vector<std::uint32_t> face(s.corners.begin() + offsets[f], s.corners.begin() + offsets[f + 1]);
+    const std::size_t i = in.ConsumeIntegralInRange<std::size_t>(0, face.size() - 1);
+    const std::uint32_t u = face[i], v = face[(i + 1) % face.size()];
+    auto new_vertex = [&](std::uint32_t near) {
+      const hedge::Point p = s.positions[near];
+      s.positions.push_back({p[0] + 0.5f * float(in.ConsumeIntegralInRange<int>(-2, 2)),
+                             p[1] + 0.5f * float(in.ConsumeIntegralInRange<int>(-2, 2)), p[2] + 0.5f});
+      return std::uint32_t(s.positions.size() - 1);
+    };
+    switch (in.ConsumeIntegralInRange<int>(0, 3)) {
+      case 0: {  // fin
+        const std::uint32_t p = new_vertex(u);
+        if (in.ConsumeBool())
+          s.add_face({u, v, p});
+        else
+          s.add_face({v, u, p});
+        break;
+      }
+      case 1: {  // bow-tie
+        const std::uint32_t p = new_vertex(u), q = new_vertex(u);
+        s.add_face({u, p, q});
+        break;
+      }
+      case 2: {  // duplicate
+        if (in.ConsumeBool()) std::reverse(face.begin(), face.end());
+        std::rotate(face.begin(), face.begin() + std::ptrdiff_t(i), face.end());
+        s.add_face(face);
+        break;
+      }
+      default: {  // bridge to any vertex
+        const auto w = in.ConsumeIntegralInRange<std::uint32_t>(0, std::uint32_t(s.positions.size() - 1));
+        s.add_face({v, u, w});
+        break;
+      }
+    }
+  }
+}
+
+void validated(const Mesh& mesh, const std::string& after) {
   hedge::Validation v = hedge::validate(mesh);
-  if (!v) hedge_fuzz::fail(std::string("validate after ") + after + ": " + v.message);
+  if (!v) hedge_fuzz::fail("validate after " + after + ": " + v.message);
+}
+
+//! "No mesh comes back worse" (docs/architecture.md), held after every step: extract() given
+//! the soup the mesh was built from has no more of each defect (defect_counts.h) than is
+//! allowed, which starts as the soup's own counts. Subdivision may multiply them by its own
+//! rule, step by step; it welds its new edge points by build()'s sources, so on a mesh whose
+//! copies an earlier step made extract() keep apart (a chain no host runs: run_operation()
+//! builds afresh), the rule counts from the mesh welded by sources. Euler operations are edits, not operations: what they make in the
+//! mesh itself (extracted without welding; a valid mesh can hold only duplicate faces, such
+//! as a hole of three edges filled next to a triangle) is added to what is allowed.
+//! HEDGE_FUZZ_TRACE=1 prints every step's counts.
+class DefectRule {
+ public:
+  explicit DefectRule(const hedge::Soup& soup)
+      : soup_(soup), input_(hedge::test::count_defects(soup)), trace_(std::getenv("HEDGE_FUZZ_TRACE") != nullptr) {
+    for (int k = 0; k < 4; ++k) allowed_[k] = input_.at(k);
+    if (trace_) std::fprintf(stderr, "[rule] input: %s\n", hedge_fuzz::describe(input_).c_str());
+  }
+  void built(const Mesh& mesh) { own_ = own_defects(mesh); }
+
+  void euler(const Mesh& mesh, const std::string& what) {
+    const DefectCounts own = own_defects(mesh);
+    for (int k = 0; k < 4; ++k)
+      if (own.at(k) > own_.at(k)) allowed_[k] += own.at(k) - own_.at(k), edits_made_ += own.at(k) - own_.at(k);
+    own_ = own;
+    check(mesh, what);
+  }
+
+  //! Before a subdivision: the defects of the mesh welded by sources alone.
+  static DefectCounts by_sources(const Mesh& mesh) { return hedge::test::count_defects(hedge::extract(mesh)); }
+
+  void catalogue(const Mesh& mesh, const hedge::Operation& op, const hedge::ParamValues& params,
+                 const DefectCounts& welded_by_sources) {
+    if (op.id == "subdivide") {
+      for (int k = 0; k < 4; ++k) allowed_[k] = std::max(allowed_[k], welded_by_sources.at(k));
+      for (std::int64_t i = 0; i < params.get_int("iterations"); ++i, ++subdivisions_) {
+        allowed_[0] = 2 * allowed_[0] + 3 * allowed_[2];
+        allowed_[2] *= 4;
+      }
+    }
+    own_ = own_defects(mesh);
+    check(mesh, op.id);
+  }
+
+ private:
+  static DefectCounts own_defects(const Mesh& mesh) {
+    hedge::ExtractOptions options;
+    options.restore_source = false;
+    return hedge::test::count_defects(hedge::extract(mesh, options));
+  }
+
+  void check(const Mesh& mesh, const std::string& what) {
+    hedge::ExtractOptions options;
+    options.input = &soup_;
+    hedge::ExtractReport report;
+    const hedge::Soup welded = hedge::extract(mesh, options, &report);
+    const DefectCounts out = hedge::test::count_defects(welded);
+    if (trace_)
+      std::fprintf(stderr, "[rule] %s: %s (allowed %zu/%zu/%zu/%zu; unwelded %s; %zu copies kept apart)\n",
+                   what.c_str(), hedge_fuzz::describe(out).c_str(), allowed_[0], allowed_[1], allowed_[2], allowed_[3],
+                   hedge_fuzz::describe(own_).c_str(), report.copies_kept_apart);
+    for (int k = 0; k < 4; ++k)
+      if (out.at(k) > allowed_[k]) {
+        if (trace_) {
+          std::fprintf(stderr, "[rule] input faces:%s\n[rule] output faces:%s\n", faces(soup_).c_str(),
+                       faces(welded).c_str());
+          hedge::ExtractOptions own;
+          own.restore_source = false;
+          std::fprintf(stderr, "[rule] unwelded faces:%s\n", faces(hedge::extract(mesh, own)).c_str());
+        }
+        hedge_fuzz::fail("extract(mesh, input = soup) after " + what + " has " + std::to_string(out.at(k)) + " " +
+                         DefectCounts::kNames[k] + ", more than the " + std::to_string(allowed_[k]) +
+                         " allowed; input: " + hedge_fuzz::describe(input_) + "; output: " + hedge_fuzz::describe(out) +
+                         "; " + std::to_string(subdivisions_) + " subdivision steps, " + std::to_string(edits_made_) +
+                         " defects made by Euler edits in the mesh itself, " +
+                         std::to_string(report.copies_kept_apart) + " copies kept apart");
+      }
+  }
+
+  static std::string faces(const hedge::Soup& s) {
+    std::string text;
+    const std::vector<std::size_t> offsets = s.face_offsets();
+    for (std::size_t f = 0; f < s.n_faces(); ++f) {
+      text += " {";
+      for (std::size_t c = offsets[f]; c < offsets[f + 1]; ++c)
+        text += (c > offsets[f] ? " " : "") + std::to_string(s.corners[c]);
+      text += "}";
+    }
+    return text;
+  }
+
+  const hedge::Soup& soup_;
+  const DefectCounts input_;
+  const bool trace_;
+  std::size_t allowed_[4] = {};
+  DefectCounts own_;
+  std::size_t subdivisions_ = 0, edits_made_ = 0;
+};
+
+void check(DefectRule& rule, const Mesh& mesh, const char* after) {
+  validated(mesh, after);
+  rule.euler(mesh, after);
 }
 
 template <class H>
@@ -162,7 +316,7 @@ double remesh_forecast(const Mesh& mesh, const hedge::ParamValues& params) {
   return length > 0 ? stats.area / (std::sqrt(3.0) / 4 * length * length) : 0;
 }
 
-void run_catalogue(FuzzedDataProvider& in, Mesh& mesh) {
+void run_catalogue(FuzzedDataProvider& in, Mesh& mesh, DefectRule& rule) {
   const auto& ops = hedge::catalogue();
   const hedge::Operation& op = ops[in.ConsumeIntegralInRange<std::size_t>(0, ops.size() - 1)];
   hedge::ParamValues params = draw_params(in, op);
@@ -172,13 +326,15 @@ void run_catalogue(FuzzedDataProvider& in, Mesh& mesh) {
   if (op.id == "remesh" && remesh_forecast(mesh, params) > 40.0 * max_faces) return;
   mesh.garbage_collect();
   Mesh before = mesh;
+  const DefectCounts welded_by_sources = op.id == "subdivide" ? DefectRule::by_sources(mesh) : DefectCounts{};
   try {
     op.run(mesh, params, hedge::Progress::none());
   } catch (const hedge::Error&) {
     mesh = before;  // operations may throw on meshes they do not take; their input is copied
     return;
   }
-  check(mesh, op.id.c_str());
+  validated(mesh, op.id);
+  rule.catalogue(mesh, op, params, welded_by_sources);
 }
 
 }  // namespace
@@ -186,20 +342,28 @@ void run_catalogue(FuzzedDataProvider& in, Mesh& mesh) {
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   FuzzedDataProvider in(data, size);
   hedge::Soup soup;
-  switch (in.ConsumeIntegralInRange<int>(0, 4)) {
+  // The second byte from the end: how many faces to glue on. (Inputs made before it existed
+  // replay as they did with a zero byte inserted before their last.)
+  const int shape = in.ConsumeIntegralInRange<int>(0, 4), glue = in.ConsumeIntegralInRange<int>(0, 7);
+  switch (shape) {
     case 0: soup = grid(3, true); break;
     case 1: soup = grid(3, false); break;
     case 2: soup = icosahedron(); break;
     case 3: soup = cube(); break;
     default: soup = random_faces(in); break;
   }
-  Mesh mesh;
+  add_defects(in, soup, glue);
+  hedge::BuildResult built;
   try {
-    mesh = std::move(hedge::build(soup).mesh);
+    built = hedge::build(soup);
   } catch (const hedge::Error&) {
     return 0;
   }
-  check(mesh, "build");
+  validated(built.mesh, "build");
+  hedge_fuzz::check_extract_with_input(built, soup, hedge_fuzz::expected_round_trip(soup, built.maps.skipped_faces));
+  Mesh mesh = std::move(built.mesh);
+  DefectRule rule(soup);
+  rule.built(mesh);
 
   for (int step = 0; step < 24 && in.remaining_bytes() > 0; ++step) {
     bool small = mesh.n_faces() < max_faces;
@@ -208,12 +372,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     Vertex v;
     switch (in.ConsumeIntegralInRange<int>(0, 13)) {
       case 0:
-        if (pick(in, mesh, mesh.edges_size(), e) && mesh.is_flip_ok(e)) mesh.flip(e), check(mesh, "flip");
+        if (pick(in, mesh, mesh.edges_size(), e) && mesh.is_flip_ok(e)) mesh.flip(e), check(rule, mesh, "flip");
         break;
       case 1:
         if (small && pick(in, mesh, mesh.edges_size(), e)) {
           mesh.split_edge(e, mesh.add_vertex(midpoint(mesh, e)));
-          check(mesh, "split_edge");
+          check(rule, mesh, "split_edge");
         }
         break;
       case 2:
@@ -222,16 +386,16 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
           try {
             mesh.split_edge_triangles(e, nv);
           } catch (const hedge::Error&) {
-            check(mesh, "refused split_edge_triangles");
+            check(rule, mesh, "refused split_edge_triangles");
             mesh.remove_isolated_vertex(nv);
           }
-          check(mesh, "split_edge_triangles");
+          check(rule, mesh, "split_edge_triangles");
         }
         break;
       case 3:
         if (small && pick(in, mesh, mesh.faces_size(), f)) {
           mesh.split_face(f, mesh.add_vertex(centroid(mesh, f)));
-          check(mesh, "split_face");
+          check(rule, mesh, "split_face");
         }
         break;
       case 4: {
@@ -239,16 +403,18 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         if (pick(in, mesh, mesh.halfedges_size(), h0) && pick(in, mesh, mesh.halfedges_size(), h1) &&
             mesh.is_insert_ok(h0, h1)) {
           mesh.insert_edge(h0, h1);
-          check(mesh, "insert_edge");
+          check(rule, mesh, "insert_edge");
         }
         break;
       }
       case 5:
-        if (pick(in, mesh, mesh.edges_size(), e) && mesh.is_removal_ok(e)) mesh.remove_edge(e), check(mesh, "remove_edge");
+        if (pick(in, mesh, mesh.edges_size(), e) && mesh.is_removal_ok(e))
+          mesh.remove_edge(e), check(rule, mesh, "remove_edge");
         break;
       case 6: {
         Halfedge h;
-        if (pick(in, mesh, mesh.halfedges_size(), h) && mesh.is_collapse_ok(h)) mesh.collapse(h), check(mesh, "collapse");
+        if (pick(in, mesh, mesh.halfedges_size(), h) && mesh.is_collapse_ok(h))
+          mesh.collapse(h), check(rule, mesh, "collapse");
         break;
       }
       case 7: {
@@ -262,14 +428,14 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
           } catch (const hedge::Error&) {
             if (mesh.n_faces() != faces) hedge_fuzz::fail("refused fill_hole changed the face count");
           }
-          check(mesh, "fill_hole");
+          check(rule, mesh, "fill_hole");
         }
         break;
       }
       case 8:
         if (pick(in, mesh, mesh.faces_size(), f) && is_delete_face_ok(mesh, f)) {
           mesh.delete_face(f);
-          check(mesh, "delete_face");
+          check(rule, mesh, "delete_face");
         }
         break;
       case 9:
@@ -278,7 +444,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
             mesh.triangulate(f);
           } catch (const hedge::Error&) {
           }
-          check(mesh, "triangulate(face)");
+          check(rule, mesh, "triangulate(face)");
         }
         break;
       case 10: {
@@ -293,27 +459,27 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         } catch (const hedge::Error&) {
           if (mesh.n_faces() != faces) hedge_fuzz::fail("refused add_face changed the face count");
         }
-        check(mesh, "add_face");
+        check(rule, mesh, "add_face");
         break;
       }
       case 11:
         if (pick(in, mesh, mesh.vertices_size(), v) && mesh.is_isolated(v)) {
           mesh.remove_isolated_vertex(v);
-          check(mesh, "remove_isolated_vertex");
+          check(rule, mesh, "remove_isolated_vertex");
         }
         break;
       case 12:
         mesh.garbage_collect();
-        check(mesh, "garbage_collect");
+        check(rule, mesh, "garbage_collect");
         break;
       default:
-        if (mesh.n_faces() <= max_faces) run_catalogue(in, mesh);
+        if (mesh.n_faces() <= max_faces) run_catalogue(in, mesh, rule);
         break;
     }
   }
   // Whatever the sequence made must extract and build again.
   mesh.garbage_collect();
   hedge::Soup out = hedge::extract(mesh);
-  hedge_fuzz::check_build_round_trip(out);
+  hedge_fuzz::check_build_round_trip(out, /*with_input=*/true);
   return 0;
 }
