@@ -42,6 +42,9 @@ struct DecimateOptions {
   //! Threads for measuring every edge before the first collapse (the collapses themselves
   //! are sequential); the result is the same for any count.
   unsigned threads = 2;
+  //! Keep a copy of the mesh while working, so that a cancelled or failed run leaves it as
+  //! it was. run_operation() turns it off: its mesh is built for the run and dropped on failure.
+  bool keep_input_on_failure = true;
 };
 
 struct DecimateReport {

@@ -20,6 +20,9 @@ struct DelaunayOptions {
   double angle_epsilon = 1e-6;
   //! Flips allowed per edge of the mesh before giving up (curved surfaces may not converge).
   double flip_budget_per_edge = 50;
+  //! Keep a copy of the mesh while working, so that a cancelled or failed run leaves it as
+  //! it was. run_operation() turns it off: its mesh is built for the run and dropped on failure.
+  bool keep_input_on_failure = true;
 };
 
 //! Why interior edges are left non-Delaunay, counted over the whole mesh after flipping.
@@ -28,8 +31,9 @@ struct DelaunayCensus {
   std::size_t non_delaunay = 0;  //!< all interior edges failing the angle test, whatever the reason
   std::size_t features = 0;      //!< of those: dihedral angle above feature_angle
   std::size_t seams = 0;         //!< of those: corner or face attributes differ across the edge
-  std::size_t blocked = 0;       //!< of those: is_flip_ok refuses (the other diagonal exists, valence 3), or the weld of build()'s
-                                 //!< copies would meet the flip (a split non-manifold edge, a new edge already there)
+  //! of those: is_flip_ok refuses (the other diagonal exists, valence 3), or the weld of
+  //! build()'s copies would meet the flip (a split non-manifold edge, a new edge already there)
+  std::size_t blocked = 0;
   std::size_t folds = 0;         //!< of those: the flipped edge would be a feature or turn a triangle over
   std::size_t flippable = 0;     //!< of those: none of the above (0 unless the budget ran out)
 };

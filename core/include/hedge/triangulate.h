@@ -28,6 +28,9 @@ const char* triangulation_method_name(TriangulationMethod method);
 struct TriangulateOptions {
   TriangulationMethod method = TriangulationMethod::min_area;
   std::size_t max_dp_corners = 100;  //!< min_area: larger polygons are ear-clipped
+  //! Keep a copy of the mesh while working, so that a cancelled or failed run leaves it as
+  //! it was. run_operation() turns it off: its mesh is built for the run and dropped on failure.
+  bool keep_input_on_failure = true;
 };
 
 struct TriangulateReport {

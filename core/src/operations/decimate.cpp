@@ -1232,7 +1232,7 @@ DecimateReport decimate(Mesh& mesh, const DecimateOptions& options, Progress& pr
   check_options(options);
   // Only a caller-supplied progress can cancel half-way; keep a copy to restore then.
   std::optional<Mesh> backup;
-  if (&progress != &Progress::none()) backup = mesh;
+  if (options.keep_input_on_failure && &progress != &Progress::none()) backup = mesh;
   try {
     return Decimator(mesh, options, progress).run();
   } catch (...) {
@@ -1287,6 +1287,7 @@ Operation decimate_operation() {
     o.preserve_uv_seams = params.get_bool("preserve_uv_seams");
     o.prevent_flips = params.get_bool("prevent_flips");
     o.min_quality = params.get_real("min_quality");
+    o.keep_input_on_failure = false;
     const DecimateReport r = decimate(mesh, o, progress);
     OperationReport report;
     auto count = [](std::size_t n) { return static_cast<std::int64_t>(n); };

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <numbers>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -154,7 +155,9 @@ DelaunayReport make_delaunay(Mesh& mesh, const DelaunayOptions& options, Progres
 
   DelaunayReport report;
   progress.update(0.0, "checking edges");
-  Mesh work = mesh;  // flips happen on a copy, so a cancellation leaves the input as it was
+  // Flips happen on a copy, so a cancellation leaves the input as it was.
+  std::optional<Mesh> copy;
+  Mesh& work = options.keep_input_on_failure ? copy.emplace(mesh) : mesh;
   report.before = delaunay_census(work, options);
   const Seams seams(work);
   const detail::WeldedCopies copies(work);
@@ -195,7 +198,7 @@ DelaunayReport make_delaunay(Mesh& mesh, const DelaunayOptions& options, Progres
   }
   progress.update(0.95, "checking edges");
   report.after = delaunay_census(work, options);
-  mesh = std::move(work);
+  if (copy) mesh = std::move(*copy);
   if (report.flips) refresh_normal_channels(mesh, false, true);  // flipped faces have new shapes
   return report;
 }
@@ -224,6 +227,7 @@ Operation make_delaunay_operation() {
   op.run = [](Mesh& mesh, const ParamValues& values, Progress& progress) {
     DelaunayOptions options;
     options.feature_angle = values.get_real("feature_angle");
+    options.keep_input_on_failure = false;
     DelaunayReport r = make_delaunay(mesh, options, progress);
     OperationReport report;
     auto count = [](std::size_t n) { return std::int64_t(n); };

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <unordered_map>
 #include <unordered_set>
 #include <utility>
@@ -433,7 +434,9 @@ TriangulateReport triangulate(Mesh& mesh, const TriangulateOptions& options, Pro
   report.polygons = polygons.size();
   if (polygons.empty()) return report;
 
-  Mesh work = mesh;  // cut on a copy: an error or a cancellation leaves the input as it was
+  // Cut on a copy: an error or a cancellation leaves the input as it was.
+  std::optional<Mesh> copy;
+  Mesh& work = options.keep_input_on_failure ? copy.emplace(mesh) : mesh;
   std::vector<std::array<std::size_t, 3>> triangles;
   for (std::size_t k = 0; k < polygons.size(); ++k) {
     if ((k & 1023) == 0) progress.update(double(k) / double(polygons.size()), "triangulating");
@@ -460,7 +463,7 @@ TriangulateReport triangulate(Mesh& mesh, const TriangulateOptions& options, Pro
     }
     report.triangles += cutter.added() + 1;  // the polygon's own face is the last triangle
   }
-  mesh = std::move(work);
+  if (copy) mesh = std::move(*copy);
   return report;
 }
 
@@ -487,6 +490,7 @@ Operation triangulate_operation() {
   op.run = [](Mesh& mesh, const ParamValues& values, Progress& progress) {
     TriangulateOptions options;
     options.method = triangulation_method_from_name(values.get_choice("method"));
+    options.keep_input_on_failure = false;
     TriangulateReport r = triangulate(mesh, options, progress);
     OperationReport report;
     auto count = [](std::size_t n) { return std::int64_t(n); };
