@@ -230,8 +230,6 @@ constexpr double kBoundaryWeight = 10;
 // 10% more mean error and no change in the Hausdorff distance on the dragon.
 constexpr double kPull = 0.01;
 
-bool is_internal(const PropertyArray& a) { return a.name().starts_with("hedge:"); }
-
 class Decimator {
  public:
   Decimator(Mesh& mesh, const DecimateOptions& options, Progress& progress)
@@ -473,7 +471,7 @@ void Decimator::find_corner_channels() {
   PropertyContainer& hp = m_.halfedge_properties();
   for (std::size_t i = 0; i < hp.count(); ++i) {
     PropertyArray& a = hp.at(i);
-    if (a.type() == typeid(ChannelArray) && !is_internal(a)) corner_channels_.push_back(static_cast<ChannelArray*>(&a));
+    if (a.type() == typeid(ChannelArray) && !a.is_internal()) corner_channels_.push_back(static_cast<ChannelArray*>(&a));
   }
   seam_mode_ = opt_.preserve_uv_seams && !corner_channels_.empty();
 
@@ -481,7 +479,7 @@ void Decimator::find_corner_channels() {
   for (std::size_t i = 0; i < vp.count(); ++i) {
     PropertyArray& a = vp.at(i);
     ChannelArray* channel = nullptr;
-    if (a.type() == typeid(ChannelArray) && !is_internal(a)) channel = static_cast<ChannelArray*>(&a);
+    if (a.type() == typeid(ChannelArray) && !a.is_internal()) channel = static_cast<ChannelArray*>(&a);
     vertex_arrays_.push_back({&a, channel});
     vertex_channels_ = vertex_channels_ || channel;
   }
@@ -1000,7 +998,7 @@ void Decimator::interpolate_vertex(Vertex removed, Vertex kept, const Candidate&
   for (const VertexArray& a : vertex_arrays_) {
     // Where a copy goes, the kept vertex keeps its own source: taking the copy's would weld
     // it to the copy's other copies.
-    if (copies && !a.channel && is_internal(*a.array)) continue;
+    if (copies && !a.channel && a.array->is_internal()) continue;
     if (a.channel && vertex_blend_size_ == 3 && a.channel->stride() <= 256) {
       // Deleted vertices keep their rows until garbage collection: the removed end's too.
       std::byte out[256];

@@ -25,10 +25,9 @@ constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
 // ---- attributes ---------------------------------------------------------------------------
 
-// "hedge:*" arrays are internal bookkeeping about where elements came from (build()'s
-// provenance); patch elements came from nowhere, so they keep the array's default.
-bool is_internal(const PropertyArray& a) { return a.name().starts_with("hedge:"); }
-
+// build()'s provenance ("hedge:*" arrays) says where elements came from; patch elements
+// came from nowhere, so they keep the arrays' defaults (reset_internal), and blends and
+// copies leave those arrays alone.
 template <class T>
 bool reset_typed(PropertyArray& a, Index i) {
   auto* t = dynamic_cast<TypedArray<T>*>(&a);
@@ -40,7 +39,7 @@ bool reset_typed(PropertyArray& a, Index i) {
 void reset_internal(PropertyContainer& c, Index i) {
   for (std::size_t k = 0; k < c.count(); ++k) {
     PropertyArray& a = c.at(k);
-    if (!is_internal(a)) continue;
+    if (!a.is_internal()) continue;
     (void)(reset_typed<bool>(a, i) || reset_typed<std::uint8_t>(a, i) || reset_typed<std::int8_t>(a, i) ||
            reset_typed<std::uint16_t>(a, i) || reset_typed<std::int16_t>(a, i) || reset_typed<std::uint32_t>(a, i) ||
            reset_typed<std::int32_t>(a, i) || reset_typed<std::uint64_t>(a, i) || reset_typed<std::int64_t>(a, i) ||
@@ -52,12 +51,12 @@ void reset_internal(PropertyContainer& c, Index i) {
 void interpolate_attributes(PropertyContainer& c, Index to, std::span<const Index> from,
                             std::span<const float> weights) {
   for (std::size_t k = 0; k < c.count(); ++k)
-    if (!is_internal(c.at(k))) c.at(k).interpolate(to, from, weights);
+    if (!c.at(k).is_internal()) c.at(k).interpolate(to, from, weights);
 }
 
 void copy_attributes(PropertyContainer& c, Index from, Index to) {
   for (std::size_t k = 0; k < c.count(); ++k)
-    if (!is_internal(c.at(k))) c.at(k).copy_element(from, to);
+    if (!c.at(k).is_internal()) c.at(k).copy_element(from, to);
   reset_internal(c, to);
 }
 

@@ -20,10 +20,6 @@
 namespace hedge {
 namespace {
 
-// "hedge:*" arrays are build()'s provenance: a vertex made in the middle of an edge has no
-// source vertex, so it keeps the arrays' defaults instead of a blend.
-bool is_internal(const PropertyArray& a) { return a.name().starts_with("hedge:"); }
-
 // Edge flags.
 constexpr std::uint8_t kFeature = 1;  // only split: never collapsed, never flipped
 constexpr std::uint8_t kCurve = 2;    // a crease or a free boundary: its vertices slide along it
@@ -208,12 +204,12 @@ void Remesher::classify() {
   std::vector<const ChannelArray*> corner_channels, face_channels;
   for (std::size_t i = 0; i < mesh_.halfedge_properties().count(); ++i) {
     const PropertyArray& a = mesh_.halfedge_properties().at(i);
-    if (a.type() == typeid(ChannelArray) && !is_internal(a))
+    if (a.type() == typeid(ChannelArray) && !a.is_internal())
       corner_channels.push_back(static_cast<const ChannelArray*>(&a));
   }
   for (std::size_t i = 0; i < mesh_.face_properties().count(); ++i) {
     const PropertyArray& a = mesh_.face_properties().at(i);
-    if (a.type() == typeid(ChannelArray) && !is_internal(a))
+    if (a.type() == typeid(ChannelArray) && !a.is_internal())
       face_channels.push_back(static_cast<const ChannelArray*>(&a));
   }
   auto same = [](const ChannelArray* c, Index a, Index b) {
@@ -787,7 +783,7 @@ void Remesher::resample_attributes() {
   auto collect = [](const PropertyContainer& in, PropertyContainer& out, std::vector<Pair>& pairs) {
     for (std::size_t i = 0; i < out.count(); ++i) {
       PropertyArray& a = out.at(i);
-      if (a.type() != typeid(ChannelArray) || is_internal(a)) continue;
+      if (a.type() != typeid(ChannelArray) || a.is_internal()) continue;
       const ChannelArray* src = in.get_channel(a.name());
       auto* dst = static_cast<ChannelArray*>(&a);
       if (src && src->scalar() == dst->scalar() && src->components() == dst->components()) pairs.push_back({src, dst});
@@ -880,9 +876,11 @@ RemeshReport Remesher::run() {
   first_triangle_.assign(input_.faces_size(), 0);
   for (Index t = static_cast<Index>(surface_.n_triangles()); t-- > 0;) first_triangle_[surface_.face(t).idx()] = t;
   for (std::size_t i = 0; i < mesh_.vertex_properties().count(); ++i)
-    if (!is_internal(mesh_.vertex_properties().at(i))) vertex_arrays_.push_back(&mesh_.vertex_properties().at(i));
+    // build()'s provenance ("hedge:*") is not blended: a vertex made in the middle of an edge
+    // has no source vertex, so it keeps the arrays' defaults.
+    if (!mesh_.vertex_properties().at(i).is_internal()) vertex_arrays_.push_back(&mesh_.vertex_properties().at(i));
   for (std::size_t i = 0; i < mesh_.halfedge_properties().count(); ++i)
-    if (!is_internal(mesh_.halfedge_properties().at(i))) corner_arrays_.push_back(&mesh_.halfedge_properties().at(i));
+    if (!mesh_.halfedge_properties().at(i).is_internal()) corner_arrays_.push_back(&mesh_.halfedge_properties().at(i));
 
   progress_.update(0.03, "finding features");
   classify();

@@ -72,8 +72,6 @@ class Stencil {
   std::size_t size_ = 0, capacity_ = kInline;
 };
 
-bool is_internal(const PropertyArray& a) { return a.name().starts_with("hedge:"); }
-
 //! A property array with its fast path resolved once (f32 host channels are the common case
 //! and the generic interpolate() allocates per call).
 struct Target {
@@ -95,7 +93,7 @@ std::vector<Target> targets(PropertyContainer& c) {
   for (std::size_t i = 0; i < c.count(); ++i) {
     Target t;
     t.array = &c.at(i);
-    t.internal = is_internal(*t.array);
+    t.internal = t.array->is_internal();
     if (t.array->type() == typeid(ChannelArray)) {
       auto* ch = static_cast<ChannelArray*>(t.array);
       if (ch->scalar() == ScalarType::f32 && ch->components() <= 16) t.f32 = ch;

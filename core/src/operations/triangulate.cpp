@@ -27,8 +27,6 @@ double orient(const Vec2d& a, const Vec2d& b, const Vec2d& c) {
   return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
 }
 
-bool is_internal(const PropertyArray& a) { return a.name().starts_with("hedge:"); }
-
 //! Reflex corners in a 2D tree of boxes (median splits), queried with a triangle: subtrees
 //! whose box lies outside one of the triangle's edges are skipped. Unlike a grid, a long thin
 //! ear (fans toward a far corner are common) only visits the corners near its border.
@@ -279,7 +277,7 @@ class Cutter {
     const std::vector<float> weights(from.size(), 1.0f / float(from.size()));
     PropertyContainer& props = m_.vertex_properties();
     for (std::size_t a = 0; a < props.count(); ++a)
-      if (!is_internal(props.at(a))) props.at(a).interpolate(v.idx(), from, weights);
+      if (!props.at(a).is_internal()) props.at(a).interpolate(v.idx(), from, weights);
     m_.split_face(face_, v);
     added_ += remaining_ - 1;
     remaining_ = 0;
