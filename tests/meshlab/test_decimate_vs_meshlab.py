@@ -18,9 +18,11 @@ def distance(ml, a, b):
     return json.loads(done.stdout)
 
 
-def non_manifold(ml, path):
-    repairs = ml.info(path)["repairs"]
-    return repairs["non_manifold_edges"], repairs["non_manifold_vertices"]
+def non_manifold(path):
+    """Non-manifold edges and vertices as defects.py counts them, from the file alone (hedge's
+    own build report counts every vertex it splits, those on non-manifold edges too)."""
+    counts = mt.count_defects(path)
+    return counts["non_manifold_edges"], counts["non_manifold_vertices"]
 
 
 def compare(ml, checks, name):
@@ -57,7 +59,7 @@ def compare(ml, checks, name):
     checks.check(ours["flipped_faces"] == 0,
                  f"{name}: no face of Hedge's result turned over ({ours['flipped_faces']}; "
                  f"MeshLab's result: {theirs['flipped_faces']})")
-    before, after = non_manifold(ml, source), non_manifold(ml, results["hedge"][0])
+    before, after = non_manifold(source), non_manifold(results["hedge"][0])
     checks.check(after[0] <= before[0] and after[1] <= before[1],
                  f"{name}: no non-manifold edge or vertex added (edges {before[0]} -> {after[0]}, "
                  f"vertices {before[1]} -> {after[1]})")
