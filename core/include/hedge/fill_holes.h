@@ -46,8 +46,10 @@ struct FillHolesReport {
   std::size_t holes_filled = 0;
   std::size_t holes_skipped = 0;    //!< left open: the three kinds below
   std::size_t holes_too_large = 0;  //!< more than max_hole_edges edges
-  std::size_t lone_faces = 0;       //!< the border of a face with no neighbour (filling would double it)
-  std::size_t slits = 0;            //!< loops of two edges joining the same two vertices (no triangle fits)
+  //! the border of a face with no neighbour, or a hole of three edges whose corners have a
+  //! face already (filling would double it)
+  std::size_t lone_faces = 0;
+  std::size_t slits = 0;        //!< loops of two edges joining the same two vertices (no triangle fits)
   std::size_t split_seams = 0;  //!< loops along non-manifold edges build() split: not holes, not counted in holes_found
   std::size_t largest_skipped_edges = 0;
   std::size_t triangles_added = 0;

@@ -25,6 +25,22 @@ constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
 // ---- attributes ---------------------------------------------------------------------------
 
+// Whether a triangle on the corners of the three-edge hole at `start` exists already: the
+// only way to fill the hole would give a second face on the same vertices. Where build()
+// kept two edges between one pair of vertices, that is not only the lone face across the
+// hole. (A triangle that only the weld of copies would make the same is extract()'s to
+// keep apart.)
+bool triangle_exists(const Mesh& mesh, Halfedge start) {
+  const Vertex a = mesh.from_vertex(start), b = mesh.to_vertex(start), c = mesh.to_vertex(mesh.next(start));
+  for (Face f : mesh.faces(a)) {
+    if (!f.is_valid() || mesh.valence(f) != 3) continue;
+    int found = 0;
+    for (Vertex v : mesh.vertices(f)) found += v == a || v == b || v == c;
+    if (found == 3) return true;
+  }
+  return false;
+}
+
 // build()'s provenance ("hedge:*" arrays) says where elements came from; patch elements
 // came from nowhere, so they keep the arrays' defaults (reset_internal), and blends and
 // copies leave those arrays alone.
@@ -731,7 +747,7 @@ FillHolesReport fill_holes(Mesh& input, const FillHolesOptions& options, Progres
     bool lone = true;
     for (Halfedge b : input.loop(hole.start))
       if (input.face(Mesh::opposite(b)) != only) lone = false;
-    if (lone) {
+    if (lone || (hole.edges == 3 && triangle_exists(input, hole.start))) {
       ++report.lone_faces;
       continue;
     }
@@ -745,7 +761,8 @@ FillHolesReport fill_holes(Mesh& input, const FillHolesOptions& options, Progres
                               std::to_string(report.largest_skipped_edges) + ")");
   if (report.lone_faces)
     report.messages.push_back(std::to_string(report.lone_faces) +
-                              " single faces with no neighbour left open (filling would only double them)");
+                              " holes left open that a face on the same corners would fill (a single face's "
+                              "other side): filling would only double that face");
   if (report.split_seams)
     report.messages.push_back(std::to_string(report.split_seams) +
                               " boundary loops along non-manifold edges left open (the input's surface is "
