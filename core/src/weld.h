@@ -21,8 +21,8 @@ struct Weld {
 
 //! Compares the welded output with `input`, the soup build() was given, around every output
 //! vertex that welds two or more copies of an input vertex, and gives copies their own output
-//! vertex (appended to `order`) until the output has no non-manifold edge, non-manifold vertex
-//! or duplicate face there that the input did not have. Sources past the input's vertices
+//! vertex (appended to `order`) until the output has no non-manifold edge, non-manifold vertex,
+//! duplicate face or face repeating a vertex there beyond what the input had. Sources past the input's vertices
 //! are an operation's own welds (subdivision's split-edge points): the non-manifold edges
 //! and duplicate faces they make follow the operation's rule and stay; their non-manifold
 //! vertices do not. Returns the number of copies moved.
