@@ -1,5 +1,6 @@
 // The `hedge` command line: info, convert, and every catalogue operation
 // (`hedge OP IN OUT --param value`), generated from the catalogue.
+#include <cctype>
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
@@ -15,6 +16,9 @@
 #include "hedge/distance.h"
 #include "hedge/error.h"
 #include "hedge/io.h"
+#ifdef HEDGE_HAS_OPENMESH
+#include "hedge/openmesh.h"
+#endif
 #include "hedge/report.h"
 #include "hedge/threads.h"
 #include "hedge/topology.h"
@@ -27,7 +31,7 @@ using namespace hedge;
 constexpr const char* kUsage =
     "usage:\n"
     "  hedge info FILE [--json]          counts, topology and what building repaired\n"
-    "  hedge convert IN OUT [--ascii]    between OFF, OBJ, PLY and STL\n"
+    "  hedge convert IN OUT [--ascii]    between OFF, OBJ, PLY, STL and OpenMesh's OM\n"
     "  hedge distance A B [--json] [--samples-per-face N]\n"
     "                                    symmetric Hausdorff distance between two meshes (sampled),\n"
     "                                    and the faces of B turned over against A\n"
@@ -38,6 +42,66 @@ constexpr const char* kUsage =
     "                                    its stages and a progress bar go to stderr (-q, --quiet: none);\n"
     "                                    Ctrl-C cancels, writes no OUT and exits with 130\n"
     "environment: HEDGE_THREADS=N        threads to use (default: all cores; results never depend on it)\n";
+
+// Files: hedge's own readers and writers, and OpenMesh's .om through OpenMesh's IO when
+// hedge was built with OpenMesh (the core library's IO never depends on it).
+bool is_om_file(const std::string& path) {
+  std::string extension = std::filesystem::path(path).extension().string();
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return extension == ".om";
+}
+
+#ifdef HEDGE_HAS_OPENMESH
+void warn_skipped(const std::string& path, const std::vector<openmesh::SkippedProperty>& skipped) {
+  for (const auto& s : skipped)
+    std::fprintf(stderr, "hedge: %s: %s property '%s' not carried: %s\n", path.c_str(), s.where.c_str(), s.name.c_str(),
+                 s.reason.c_str());
+}
+#else
+[[noreturn]] void no_openmesh(const std::string& path) {
+  throw Error(path + ": .om files need a hedge built with OpenMesh (libopenmesh-dev)");
+}
+#endif
+
+Soup read_file(const std::string& path) {
+  if (!is_om_file(path)) return read_mesh(path);
+#ifdef HEDGE_HAS_OPENMESH
+  std::vector<openmesh::SkippedProperty> skipped;
+  Soup soup = openmesh::read_om(path, &skipped);
+  warn_skipped(path, skipped);
+  return soup;
+#else
+  no_openmesh(path);
+#endif
+}
+
+//! Refuses an output file of unknown format before anything is read.
+void check_output_format(const std::string& path) {
+  if (!is_om_file(path)) {
+    format_from_path(path);
+    return;
+  }
+#ifndef HEDGE_HAS_OPENMESH
+  no_openmesh(path);
+#endif
+}
+
+void write_file(const Soup& soup, const std::string& path, const WriteOptions& options) {
+  if (!is_om_file(path)) return write_mesh(soup, path, options);
+#ifdef HEDGE_HAS_OPENMESH
+  const openmesh::FromSoupReport report = openmesh::write_om(soup, path);
+  warn_skipped(path, report.skipped);
+  // OpenMesh holds only manifold meshes: say what it took to write every face.
+  if (report.vertex_copies)
+    std::fprintf(stderr, "hedge: %s: %zu vertices written twice or more so that OpenMesh holds every face\n",
+                 path.c_str(), report.vertex_copies);
+  if (!report.skipped_faces.empty())
+    std::fprintf(stderr, "hedge: %s: %zu faces of fewer than 3 distinct vertices not written\n", path.c_str(),
+                 report.skipped_faces.size());
+#else
+  no_openmesh(path);
+#endif
+}
 
 std::string flag_of(const std::string& id) {
   std::string flag = "--" + id;
@@ -74,7 +138,7 @@ int info(const std::vector<std::string>& args) {
     else
       path = a;
   }
-  Soup soup = read_mesh(path);
+  Soup soup = read_file(path);
   BuildResult built = build(soup);
   TopologyStats t = topology_stats(built.mesh);
   const BuildReport& r = built.report;
@@ -118,8 +182,8 @@ int convert(const std::vector<std::string>& args) {
       files.push_back(a);
   }
   if (files.size() != 2) throw Error("convert: needs IN and OUT\n" + std::string(kUsage));
-  format_from_path(files[1]);  // refuse an unknown output format before reading
-  write_mesh(read_mesh(files[0]), files[1], options);
+  check_output_format(files[1]);  // refuse an unknown output format before reading
+  write_file(read_file(files[0]), files[1], options);
   return 0;
 }
 
@@ -147,7 +211,7 @@ int distance_command(const std::vector<std::string>& args) {
     }
   }
   if (files.size() != 2) throw Error("distance: needs two files, A and B\n" + std::string(kUsage));
-  const Mesh a = build(read_mesh(files[0])).mesh, b = build(read_mesh(files[1])).mesh;
+  const Mesh a = build(read_file(files[0])).mesh, b = build(read_file(files[1])).mesh;
   if (a.n_faces() == 0 || b.n_faces() == 0) throw Error("distance: " + files[a.n_faces() ? 1 : 0] + " has no faces");
   const double diagonal = mesh_statistics(a).bbox_diagonal;
   const HausdorffResult h = hausdorff(a, b, options);
@@ -221,7 +285,7 @@ void write_whole_or_nothing(const Soup& soup, const std::string& path, const Wri
     std::filesystem::remove(partial, ignored);
   };
   try {
-    write_mesh(soup, partial, options);
+    write_file(soup, partial, options);
     if (cli::interrupted()) throw Cancelled();
     std::filesystem::rename(partial, out);
   } catch (const Cancelled&) {
@@ -269,11 +333,11 @@ int run(const std::string& id, const std::vector<std::string>& args) {
     throw Error(op.id + ": needs " + (needed == 2 ? "IN and OUT files" : "an IN file") + "; see 'hedge help " + op.id +
                 "'");
   ParamValues params = resolve_params(op, given);  // refuse bad parameters before reading anything
-  if (op.changes_mesh) format_from_path(files[1]);
+  if (op.changes_mesh) check_output_format(files[1]);
   cli::TerminalProgress bar(!quiet);
   const auto file_name = [](const std::string& path) { return std::filesystem::path(path).filename().string(); };
   bar.update(0, "reading " + file_name(files[0]));
-  Soup soup = read_mesh(files[0]);
+  Soup soup = read_file(files[0]);
   if (cli::interrupted()) throw Cancelled();  // reading does not look at the flag itself
   Progress progress([&](double fraction, const std::string& stage) { return bar.update(fraction, stage); });
   RunResult result = run_operation(op, soup, params, progress);
