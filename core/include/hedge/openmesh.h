@@ -600,7 +600,7 @@ FromSoupReport from_soup(const Soup& soup, OMesh& mesh, const FromSoupOptions& o
 }
 
 //! The mesh type .om files are read into and written from: polygons, float positions, RGBA
-//! colours so a soup's alpha survives.
+//! colours (though OpenMesh 9's .om writer keeps RGB only: alpha reads back as 255).
 struct OmFileTraits : OpenMesh::DefaultTraits {
   typedef OpenMesh::Vec4uc Color;
 };
@@ -609,6 +609,7 @@ using OmFileMesh = OpenMesh::PolyMesh_ArrayKernelT<OmFileTraits>;
 //! Reads an OpenMesh .om file with OpenMesh's reader. Throws Error naming the file and the
 //! reason on anything that is not a readable .om file.
 inline Soup read_om(const std::string& path, std::vector<SkippedProperty>* skipped = nullptr) {
+  std::uint64_t vertices = 0, faces = 0;
   {
     // OpenMesh's reader trusts the header's counts; refuse what is plainly not an .om file first.
     std::ifstream file(path, std::ios::binary | std::ios::ate);
@@ -623,7 +624,9 @@ inline Soup read_om(const std::string& path, std::vector<SkippedProperty>* skipp
       return std::uint64_t(header[at]) | std::uint64_t(header[at + 1]) << 8 | std::uint64_t(header[at + 2]) << 16 |
              std::uint64_t(header[at + 3]) << 24;
     };
-    const std::uint64_t vertices = count(4), faces = count(8), edges = count(12);
+    vertices = count(4);
+    faces = count(8);
+    const std::uint64_t edges = count(12);
     if (vertices + faces + edges > size)
       throw Error(path + ": the header promises " + std::to_string(vertices) + " vertices, " + std::to_string(faces) +
                   " faces and " + std::to_string(edges) + " edges, more than a file of " + std::to_string(size) +
@@ -652,6 +655,11 @@ inline Soup read_om(const std::string& path, std::vector<SkippedProperty>* skipp
     const std::string said = messages.text();
     throw Error(path + ": OpenMesh could not read it" + (said.empty() ? std::string() : ": " + said));
   }
+  // OpenMesh stops quietly at the end of a file cut short.
+  if (mesh.n_vertices() != vertices || mesh.n_faces() != faces)
+    throw Error(path + ": cut short: the header promises " + std::to_string(vertices) + " vertices and " +
+                std::to_string(faces) + " faces, the file holds " + std::to_string(mesh.n_vertices()) + " and " +
+                std::to_string(mesh.n_faces()));
   // Drop the standard properties the file did not have, so they do not become zero channels.
   if (!found.vertex_has_normal()) mesh.release_vertex_normals();
   if (!found.vertex_has_color()) mesh.release_vertex_colors();
