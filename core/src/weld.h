@@ -24,8 +24,9 @@ struct Weld {
 //! vertex (appended to `order`) until the output has no non-manifold edge, non-manifold vertex,
 //! duplicate face or face repeating a vertex there beyond what the input had. Sources past the input's vertices
 //! are an operation's own welds (subdivision's split-edge points): the non-manifold edges
-//! and duplicate faces they make follow the operation's rule and stay; their non-manifold
-//! vertices do not. Returns the number of copies moved.
+//! and duplicate faces they make follow the operation's rule and stay (edits made after the
+//! operation are not checked there: extract and build first); their non-manifold vertices
+//! do not. Returns the number of copies moved.
 std::size_t keep_new_defects_apart(const Mesh& mesh, const std::vector<std::uint32_t>& source, const Soup& input,
                                    Weld& weld);
 

@@ -13,7 +13,7 @@
 #include "hedge/io.h"
 #include "hedge/report.h"
 #include "hedge/validate.h"
-#include "test_meshes.h"
+#include "defect_counts.h"
 #include "test_meshes.h"
 
 namespace hedge {
@@ -151,6 +151,18 @@ TEST(Repair, EveryDefectRepairedAndTheResultBuildsClean) {
   // Vertices: the book and the bow-tie keep their copies (+2, +1), the collapse and the
   // weld take some away (-1, -2).
   EXPECT_EQ(run.soup.n_vertices(), (5u + 2u) + (5u + 1u) + 6u + (5u - 1u) + 4u + (6u - 2u));
+}
+
+// Collapsing the zero-area faces of this soup (found by fuzzing) glues two quads into a
+// pillow: one vertex set twice. The later one goes, and the result has no defect at all.
+TEST(Repair, CollapsesLeaveNoDuplicateFace) {
+  const Soup soup = read_mesh(std::string(HEDGE_TEST_DATA) + "/repair_pinch_quad_pillow.off");
+  ASSERT_EQ(test::count_defects(soup).duplicate_faces, 0u);
+  const RunResult result = run_repair(soup);
+  const test::DefectCounts after = test::count_defects(result.soup);
+  EXPECT_EQ(after.duplicate_faces, 0u);
+  EXPECT_EQ(after.non_manifold_edges + after.non_manifold_vertices + after.repeating_faces, 0u) << after;
+  EXPECT_GE(entry(result.report, "duplicate_faces_removed"), 1);
 }
 
 TEST(Repair, CountsMatchWhatBuildReported) {

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -17,6 +18,7 @@
 #include <vector>
 
 #include "hedge/build.h"
+#include "hedge/catalogue.h"
 #include "hedge/error.h"
 #include "hedge/io.h"
 #include "hedge/normals.h"
@@ -440,6 +442,31 @@ TEST(Subdivide, SeamsOfNonManifoldInputStayClosed) {
       EXPECT_EQ(open, 4u * 2) << subdivision_scheme_name(s);  // the fin's free sides, halved twice
       EXPECT_EQ(glued, 4u) << subdivision_scheme_name(s);     // the glued edge, halved twice
     }
+  }
+}
+
+// A quad that visits vertex 0 twice (0 1 0 2) is built on two copies of it, and its two
+// sides along 0-1 become two mesh edges of one input edge. Their edge points stay apart:
+// welded, the face's pieces around the two copies would be one face twice.
+TEST(Subdivide, FaceVisitingAVertexTwiceGivesNoDuplicate) {
+  Soup soup;
+  soup.positions = {{{0, 0, 0}}, {{1, 0, 0}}, {{0, 1, 0}}, {{1, 1, 0}}};
+  for (std::uint32_t c : {0, 1, 0, 2, 1, 3, 2}) soup.corners.push_back(c);
+  soup.face_sizes = {4, 3};
+  for (auto s : {SubdivisionScheme::midpoint, SubdivisionScheme::catmull_clark}) {
+    const Operation& op = find_operation("subdivide");
+    const RunResult result =
+        run_operation(op, soup, resolve_params(op, std::map<std::string, std::string>{{"scheme", subdivision_scheme_name(s)}}), Progress::none());
+    std::set<std::vector<std::uint32_t>> sets;
+    const auto offsets = result.soup.face_offsets();
+    for (std::size_t f = 0; f < result.soup.n_faces(); ++f) {
+      std::vector<std::uint32_t> set(result.soup.corners.begin() + offsets[f],
+                                     result.soup.corners.begin() + offsets[f + 1]);
+      std::sort(set.begin(), set.end());
+      EXPECT_TRUE(sets.insert(set).second) << subdivision_scheme_name(s) << ": face " << f << " repeats a vertex set";
+    }
+    // The quad gives 4 quads; the triangle 4 triangles (midpoint) or 3 quads (Catmull-Clark).
+    EXPECT_EQ(sets.size(), s == SubdivisionScheme::midpoint ? 8u : 7u) << subdivision_scheme_name(s);
   }
 }
 

@@ -63,7 +63,8 @@ struct RepairReport {
 //! 3. duplicate faces (the same vertex set as an earlier face) are removed before that
 //!    rebuild, so the survivor glues to its neighbours;
 //! 4. faces of zero area collapse their shortest edge when the link condition allows, and
-//!    are deleted otherwise;
+//!    are deleted otherwise; faces the collapses leave over one vertex set are removed as
+//!    duplicates;
 //! 5. where a non-manifold edge's extra face stays attached at both ends (two edges join the
 //!    same two vertices, which a soup cannot express), the extra faces are removed;
 //! 6. isolated vertices are removed (optional).

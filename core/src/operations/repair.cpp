@@ -406,6 +406,24 @@ std::size_t remove_pinches(Mesh& mesh) {
   return doomed.size();
 }
 
+//! Collapses can leave two faces over one vertex set (a pillow of two faces glued on every
+//! edge, say), which extract() would hand on as a duplicate face: the later ones go.
+//! Returns the faces removed.
+std::size_t remove_duplicate_faces(Mesh& mesh) {
+  std::vector<std::uint32_t> sizes;
+  std::vector<std::uint64_t> ids;
+  std::vector<Face> faces;
+  for (Face f : mesh.faces()) {
+    faces.push_back(f);
+    sizes.push_back(static_cast<std::uint32_t>(mesh.valence(f)));
+    for (Vertex v : mesh.vertices(f)) ids.push_back(v.idx());
+  }
+  const std::vector<char> drop = later_duplicates(sizes, ids);
+  for (std::size_t i = 0; i < faces.size(); ++i)
+    if (drop[i]) mesh.delete_face(faces[i]);
+  return count_true(drop);
+}
+
 void say(RepairReport& r, std::size_t n, const std::string& what) {
   if (n) r.messages.push_back(what);
 }
@@ -527,11 +545,13 @@ RepairReport repair(Mesh& mesh, const RepairOptions& options, Progress& progress
   progress.update(0.5, "removing degenerate faces");
   report.degenerate_faces_removed += remove_degenerate_faces(work, report.degenerate_faces_deleted, progress);
   progress.update(0.7, "removing pinches");
+  const std::size_t duplicates_left = remove_duplicate_faces(work);
+  report.duplicate_faces_removed += duplicates_left;
   report.pinched_faces_removed = remove_pinches(work);
 
   // Deleting a face can leave a vertex with two fans; a round trip through a soup lets
   // build() split it like any other non-manifold vertex.
-  if (report.degenerate_faces_deleted || report.pinched_faces_removed) {
+  if (report.degenerate_faces_deleted || duplicates_left || report.pinched_faces_removed) {
     progress.update(0.8, "splitting vertices left non-manifold");
     BuildResult again = build(extract(work));
     const BuildRepairs more = build_repairs(again.mesh);

@@ -1033,9 +1033,26 @@ void weld_split_edge_points(const Mesh& before, Mesh& after) {
   for (std::size_t i = 0; i < edges.size();) {
     std::size_t j = i + 1;
     while (j < edges.size() && same(i, j)) ++j;
-    if (j - i > 1) {
+    // Copies on one face (a face that visits both ends twice) keep their points apart:
+    // welded, they would make that face's pieces one face twice over.
+    std::vector<std::vector<Index>> classes;
+    for (std::size_t k = i; k < j && j - i > 1; ++k) {
+      const Edge e(std::get<2>(edges[k]));
+      auto shares_face = [&](Index other) {
+        for (unsigned a = 0; a < 2; ++a)
+          for (unsigned b = 0; b < 2; ++b)
+            if (Face f = before.face(e, a); f.is_valid() && f == before.face(Edge(other), b)) return true;
+        return false;
+      };
+      auto fits = std::find_if(classes.begin(), classes.end(),
+                               [&](const auto& c) { return std::none_of(c.begin(), c.end(), shares_face); });
+      if (fits == classes.end()) fits = classes.insert(classes.end(), std::vector<Index>{});
+      fits->push_back(e.idx());
+    }
+    for (const auto& c : classes) {
+      if (c.size() < 2) continue;
       if (next >= kInvalidIndex) return;  // out of numbers: leave the rest unwelded
-      for (std::size_t k = i; k < j; ++k) source->vector()[V + std::get<2>(edges[k])] = std::uint32_t(next);
+      for (Index e : c) source->vector()[V + e] = std::uint32_t(next);
       ++next;
     }
     i = j;
