@@ -40,8 +40,8 @@ struct DecimateOptions {
   //! the triangles they replace were already worse.
   double min_quality = 0;
   //! Threads for measuring every edge before the first collapse (the collapses themselves
-  //! are sequential); the result is the same for any count.
-  unsigned threads = 2;
+  //! are sequential); the result is the same for any count. 0: hedge::thread_count().
+  unsigned threads = 0;
   //! Keep a copy of the mesh while working, so that a cancelled or failed run leaves it as
   //! it was. run_operation() turns it off: its mesh is built for the run and dropped on failure.
   bool keep_input_on_failure = true;
