@@ -112,7 +112,6 @@ std::string OperationReport::to_text() const {
   return out.str();
 }
 
-namespace {
 std::string json_string(const std::string& s) {
   std::string out = "\"";
   for (char c : s) {
@@ -139,15 +138,13 @@ std::string json_value(const Value& value) {
   if (const auto* d = std::get_if<double>(&value)) return std::isfinite(*d) ? number_text(*d) : "null";
   return value_text(value);
 }
-}  // namespace
 
 std::string OperationReport::to_json() const {
-  std::string out = "{";
-  for (std::size_t i = 0; i < entries.size(); ++i)
-    out += (i ? ", " : "") + json_string(entries[i].first) + ": " + json_value(entries[i].second);
-  out += std::string(entries.empty() ? "" : ", ") + "\"messages\": [";
-  for (std::size_t i = 0; i < messages.size(); ++i) out += (i ? ", " : "") + json_string(messages[i]);
-  return out + "]}";
+  JsonObject out;
+  for (const auto& [key, value] : entries) out.add(key, value);
+  std::string list = "[";
+  for (std::size_t i = 0; i < messages.size(); ++i) list += (i ? ", " : "") + json_string(messages[i]);
+  return out.raw("messages", list + "]").str();
 }
 
 const ParamSpec* Operation::find_param(const std::string& id) const {

@@ -118,12 +118,16 @@ std::string id_of(const std::string& flag) {
 }
 
 std::string json_repairs(const BuildReport& r) {
-  auto n = [](std::size_t x) { return std::to_string(x); };
-  return "{\"non_manifold_edges\": " + n(r.non_manifold_edges) +
-         ", \"non_manifold_vertices\": " + n(r.non_manifold_vertices) + ", \"vertex_copies\": " + n(r.vertex_copies) +
-         ", \"flipped_faces\": " + n(r.flipped_faces) + ", \"unorientable_edges\": " + n(r.unorientable_edges) +
-         ", \"repeated_vertex_faces\": " + n(r.repeated_vertex_faces) + ", \"skipped_faces\": " + n(r.skipped_faces) +
-         ", \"isolated_vertices\": " + n(r.isolated_vertices) + "}";
+  return JsonObject()
+      .add("non_manifold_edges", r.non_manifold_edges)
+      .add("non_manifold_vertices", r.non_manifold_vertices)
+      .add("vertex_copies", r.vertex_copies)
+      .add("flipped_faces", r.flipped_faces)
+      .add("unorientable_edges", r.unorientable_edges)
+      .add("repeated_vertex_faces", r.repeated_vertex_faces)
+      .add("skipped_faces", r.skipped_faces)
+      .add("isolated_vertices", r.isolated_vertices)
+      .str();
 }
 
 int info(const std::vector<std::string>& args) {
@@ -143,13 +147,20 @@ int info(const std::vector<std::string>& args) {
   TopologyStats t = topology_stats(built.mesh);
   const BuildReport& r = built.report;
   if (json) {
-    std::printf(
-        "{\"file\": \"%s\", \"vertices\": %zu, \"edges\": %zu, \"faces\": %zu, \"halfedges\": %zu, "
-        "\"boundary_loops\": %zu, \"components\": %zu, \"euler_characteristic\": %lld, \"genus\": %lld, "
-        "\"isolated_vertices\": %zu, \"repairs\": %s}\n",
-        path.c_str(), t.vertices, t.edges, t.faces, t.halfedges, t.boundary_loops, t.components,
-        static_cast<long long>(t.euler_characteristic), static_cast<long long>(t.genus), t.isolated_vertices,
-        json_repairs(r).c_str());
+    const std::string text = JsonObject()
+                                 .add("file", path)
+                                 .add("vertices", t.vertices)
+                                 .add("edges", t.edges)
+                                 .add("faces", t.faces)
+                                 .add("halfedges", t.halfedges)
+                                 .add("boundary_loops", t.boundary_loops)
+                                 .add("components", t.components)
+                                 .add("euler_characteristic", t.euler_characteristic)
+                                 .add("genus", t.genus)
+                                 .add("isolated_vertices", t.isolated_vertices)
+                                 .raw("repairs", json_repairs(r))
+                                 .str();
+    std::printf("%s\n", text.c_str());
     return 0;
   }
   std::printf("%s\n", path.c_str());
@@ -218,17 +229,20 @@ int distance_command(const std::vector<std::string>& args) {
   const std::size_t flipped = flipped_faces(b, TriangleTree(a));
   const double scale = diagonal > 0 ? 1 / diagonal : 0;
   if (json) {
-    auto side = [&](const OneSidedDistance& d) {
-      char buf[256];
-      std::snprintf(buf, sizeof buf, "{\"max\": %.9g, \"mean\": %.9g, \"rms\": %.9g, \"samples\": %zu}", d.max, d.mean,
-                    d.rms, d.samples);
-      return std::string(buf);
+    auto side = [](const OneSidedDistance& d) {
+      return JsonObject().add("max", d.max).add("mean", d.mean).add("rms", d.rms).add("samples", d.samples).str();
     };
-    std::printf(
-        "{\"hausdorff\": %.9g, \"hausdorff_over_diagonal\": %.9g, \"diagonal\": %.9g, \"a_to_b\": %s, "
-        "\"b_to_a\": %s, \"faces_a\": %zu, \"faces_b\": %zu, \"flipped_faces\": %zu}\n",
-        h.max, h.max * scale, diagonal, side(h.a_to_b).c_str(), side(h.b_to_a).c_str(), a.n_faces(), b.n_faces(),
-        flipped);
+    const std::string text = JsonObject()
+                                 .add("hausdorff", h.max)
+                                 .add("hausdorff_over_diagonal", h.max * scale)
+                                 .add("diagonal", diagonal)
+                                 .raw("a_to_b", side(h.a_to_b))
+                                 .raw("b_to_a", side(h.b_to_a))
+                                 .add("faces_a", a.n_faces())
+                                 .add("faces_b", b.n_faces())
+                                 .add("flipped_faces", flipped)
+                                 .str();
+    std::printf("%s\n", text.c_str());
     return 0;
   }
   std::printf("A %s: %zu faces; B %s: %zu faces\n", files[0].c_str(), a.n_faces(), files[1].c_str(), b.n_faces());

@@ -7,6 +7,7 @@
 #include <functional>
 #include <map>
 #include <string>
+#include <type_traits>
 #include <variant>
 #include <vector>
 
@@ -43,6 +44,34 @@ struct ParamSpec {
 
 using Value = std::variant<bool, std::int64_t, double, std::string>;
 std::string value_text(const Value& value);
+
+//! JSON text of a string (quoted and escaped) and of a value (a non-finite number is null).
+std::string json_string(const std::string& s);
+std::string json_value(const Value& value);
+
+//! One JSON object, keys in the order added: {"a": 1, "b": "x"}. The one way the core and
+//! the CLI write JSON, so every string is escaped.
+class JsonObject {
+ public:
+  JsonObject& add(const std::string& key, const Value& value) { return raw(key, json_value(value)); }
+  template <class T>
+    requires std::is_arithmetic_v<T>
+  JsonObject& add(const std::string& key, T x) {
+    if constexpr (std::is_same_v<T, bool>) return add(key, Value(x));
+    else if constexpr (std::is_integral_v<T>) return add(key, Value(static_cast<std::int64_t>(x)));
+    else return add(key, Value(static_cast<double>(x)));
+  }
+  JsonObject& add(const std::string& key, const char* s) { return add(key, Value(std::string(s))); }
+  //! A value already in JSON (a nested object or array).
+  JsonObject& raw(const std::string& key, const std::string& json) {
+    text_ += (text_.size() > 1 ? ", " : "") + json_string(key) + ": " + json;
+    return *this;
+  }
+  std::string str() const { return text_ + "}"; }
+
+ private:
+  std::string text_ = "{";
+};
 
 //! Checked parameter values of one run: every parameter of the operation is present.
 class ParamValues {
