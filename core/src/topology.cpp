@@ -5,6 +5,8 @@
 #include <numeric>
 #include <vector>
 
+#include "hedge/provenance.h"
+
 namespace hedge {
 namespace {
 
@@ -85,7 +87,7 @@ std::size_t face_components(const Mesh& mesh, std::vector<Index>& component_of_f
 }
 
 std::vector<bool> split_seam_edges(const Mesh& mesh) {
-  const auto* source = mesh.vertex_properties().get<std::uint32_t>("hedge:source");
+  const auto* source = mesh.vertex_properties().get<std::uint32_t>(provenance::kVertexSource);
   if (!source) return {};
   const std::uint64_t n = mesh.vertices_size();
   auto welded = [&](Vertex v) -> std::uint64_t {

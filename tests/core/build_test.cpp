@@ -17,6 +17,7 @@
 
 #include "hedge/error.h"
 #include "hedge/io.h"
+#include "hedge/provenance.h"
 #include "hedge/validate.h"
 #include "test_meshes.h"
 
@@ -264,8 +265,8 @@ TEST(Build, NonManifoldEdgeWithThreeFaces) {
   // Faces 0 and 1 glue; face 2 keeps its own edge and copies of vertices 0 and 1.
   EXPECT_EQ(counts(r.report), (Counts{.non_manifold_edges = 1, .non_manifold_vertices = 2, .vertex_copies = 2}));
   EXPECT_EQ(r.maps.vertex_source, (std::vector<std::uint32_t>{0, 1, 2, 3, 4, 0, 1}));
-  EXPECT_TRUE(r.mesh.get_vertex_property<std::uint32_t>("hedge:source"));
-  EXPECT_FALSE(r.mesh.get_face_property<bool>("hedge:flipped"));
+  EXPECT_TRUE(r.mesh.get_vertex_property<std::uint32_t>(provenance::kVertexSource));
+  EXPECT_FALSE(r.mesh.get_face_property<bool>(provenance::kFlipped));
   EXPECT_EQ(r.mesh.n_edges(), 8u);
 }
 
@@ -331,7 +332,7 @@ TEST(Build, InconsistentNeighboursAreFlipped) {
   BuildResult r = build_and_check(make_soup(4, {{0, 1, 2}, {0, 1, 3}}));
   // A tie: the lowest face keeps its orientation.
   EXPECT_EQ(counts(r.report), Counts{.flipped_faces = 1});
-  auto flipped = r.mesh.get_face_property<bool>("hedge:flipped");
+  auto flipped = r.mesh.get_face_property<bool>(provenance::kFlipped);
   ASSERT_TRUE(flipped);
   EXPECT_FALSE(flipped[Face(0)]);
   EXPECT_TRUE(flipped[Face(1)]);
@@ -340,7 +341,7 @@ TEST(Build, InconsistentNeighboursAreFlipped) {
   for (Vertex v : r.mesh.vertices(Face(1))) corners.push_back(v.idx());
   EXPECT_EQ(corners, (std::vector<Index>{0, 3, 1}));
   EXPECT_EQ(boundary_loops(r.mesh), std::vector<std::size_t>{4});
-  EXPECT_FALSE(r.mesh.get_vertex_property<std::uint32_t>("hedge:source"));
+  EXPECT_FALSE(r.mesh.get_vertex_property<std::uint32_t>(provenance::kVertexSource));
 }
 
 TEST(Build, TheMinorityIsFlipped) {
@@ -350,7 +351,7 @@ TEST(Build, TheMinorityIsFlipped) {
   BuildResult r = build_and_check(soup);
   EXPECT_EQ(counts(r.report), Counts{.flipped_faces = 3});
   EXPECT_EQ(boundary_loops(r.mesh), std::vector<std::size_t>{12});
-  auto flipped = r.mesh.get_face_property<bool>("hedge:flipped");
+  auto flipped = r.mesh.get_face_property<bool>(provenance::kFlipped);
   ASSERT_TRUE(flipped);
   for (std::uint32_t f = 0; f < 9; ++f) EXPECT_EQ(flipped[Face(f)], f % 4 == 0) << f;
 
@@ -363,7 +364,7 @@ TEST(Build, TheMinorityIsFlipped) {
 TEST(Build, OrientationCanBeSwitchedOff) {
   BuildResult r = build_and_check(make_soup(4, {{0, 1, 2}, {0, 1, 3}}), BuildOptions{.orient = false});
   EXPECT_EQ(counts(r.report), (Counts{.non_manifold_edges = 1, .non_manifold_vertices = 2, .vertex_copies = 2}));
-  EXPECT_FALSE(r.mesh.get_face_property<bool>("hedge:flipped"));
+  EXPECT_FALSE(r.mesh.get_face_property<bool>(provenance::kFlipped));
 }
 
 Soup moebius_strip(std::uint32_t n) {
@@ -432,7 +433,7 @@ TEST(Build, DegenerateFacesAreSkippedAndReported) {
   EXPECT_EQ(r.maps.skipped_faces, (std::vector<std::uint32_t>{1, 2, 3, 4, 5, 6}));
   EXPECT_EQ(counts(r.report), (Counts{.skipped_faces = 6, .isolated_vertices = 1}));
   EXPECT_EQ(r.maps.face_source, (std::vector<std::uint32_t>{0, 7}));
-  auto source = r.mesh.get_face_property<std::uint32_t>("hedge:source");
+  auto source = r.mesh.get_face_property<std::uint32_t>(provenance::kFaceSource);
   ASSERT_TRUE(source);
   EXPECT_EQ(source[Face(1)], 7u);
   ASSERT_FALSE(r.report.messages.empty());
@@ -486,7 +487,7 @@ TEST(Build, RejectsChannelsOfTheWrongLength) {
 
 TEST(Build, RejectsReservedChannelNames) {
   Soup soup = make_soup(3, {{0, 1, 2}});
-  soup.add_channel("hedge:source", Domain::vertex, ScalarType::u32, 1);
+  soup.add_channel(provenance::kVertexSource, Domain::vertex, ScalarType::u32, 1);
   EXPECT_NE(error_of(soup).find("reserved"), std::string::npos);
 }
 

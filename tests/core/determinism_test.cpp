@@ -216,8 +216,8 @@ TEST_P(Determinism, SameSoupAtEveryThreadCount) {
 INSTANTIATE_TEST_SUITE_P(Catalogue, Determinism, ::testing::ValuesIn(cases()),
                          [](const ::testing::TestParamInfo<Case>& info) { return case_name(info.param); });
 
-//! The full dragon (871,414 faces, 2.6M corners) is far above build()'s threshold for its
-//! two-way splits (65,536 corners): build and extract, as read and with a face in every
+//! The full dragon (871,414 faces, 2.6M corners) is far above the size where build()'s passes
+//! split their work (65,536 elements): build and extract, as read and with a face in every
 //! thousand reversed (which sends build() down its general path: orientation repair).
 TEST(DeterminismDragon, BuildAndExtract) {
   std::optional<Soup> dragon = load("dragon.ply", true);

@@ -17,6 +17,7 @@
 
 #include "hedge/build.h"
 #include "hedge/io.h"
+#include "hedge/provenance.h"
 #include "hedge/repair.h"
 #include "hedge/report.h"
 #include "hedge/topology.h"
@@ -331,7 +332,7 @@ TEST(FillHoles, ProvenanceOfNewElementsStaysDefault) {
   FillHolesReport r = fill_holes(mesh, options);
   ASSERT_VALID(mesh);
   ASSERT_EQ(r.holes_filled, 1u);
-  auto source = mesh.get_vertex_property<std::uint32_t>("hedge:source");
+  auto source = mesh.get_vertex_property<std::uint32_t>(provenance::kVertexSource);
   ASSERT_TRUE(source);
   for (Vertex v : mesh.vertices())
     if (v.idx() >= built.maps.vertex_source.size()) {

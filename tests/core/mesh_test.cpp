@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <vector>
 
+#include "hedge/provenance.h"
 #include "hedge/topology.h"
 #include "hedge/validate.h"
 
@@ -179,7 +180,7 @@ TEST(Mesh, InterpolateNumbersAndPickOthers) {
 TEST(Mesh, InterpolationDoesNotInheritProvenance) {
   Mesh m;
   for (int i = 0; i < 3; ++i) m.add_vertex(Point{{float(i), 0, 0}});
-  auto source = m.add_vertex_property<std::uint32_t>("hedge:source", kInvalidIndex);
+  auto source = m.add_vertex_property<std::uint32_t>(provenance::kVertexSource, kInvalidIndex);
   source[Vertex(0)] = 0;
   source[Vertex(1)] = 0;
   source[Vertex(2)] = 2;

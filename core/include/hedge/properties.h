@@ -16,6 +16,7 @@
 
 #include "hedge/error.h"
 #include "hedge/handles.h"
+#include "hedge/provenance.h"
 #include "hedge/vec.h"
 
 namespace hedge {
@@ -31,9 +32,9 @@ class PropertyArray {
   explicit PropertyArray(std::string name) : name_(std::move(name)) {}
   virtual ~PropertyArray() = default;
   const std::string& name() const { return name_; }
-  //! build()'s provenance ("hedge:source", "hedge:flipped", ...): bookkeeping about where an
-  //! element came from, which a new element made from several old ones does not inherit.
-  bool is_internal() const { return name_.starts_with("hedge:"); }
+  //! build()'s provenance (hedge/provenance.h): bookkeeping about where an element came
+  //! from, which a new element made from several old ones does not inherit.
+  bool is_internal() const { return name_.starts_with(provenance::kPrefix); }
 
   virtual std::size_t size() const = 0;
   virtual void resize(std::size_t n) = 0;

@@ -21,7 +21,7 @@ unsigned resolve_thread_count(unsigned requested);
 namespace testing {
 //! For tests only: the smallest range of elements a parallel part gives a thread (0, the
 //! default: each part's own tuned value), so that small meshes take the multi-threaded
-//! paths. build()'s two-way splits keep their own threshold.
+//! paths.
 void set_parallel_grain(std::size_t elements);
 std::size_t parallel_grain();
 //! How many times a parallel part has split its work across two or more threads, so that

@@ -11,6 +11,7 @@
 
 #include "hedge/error.h"
 #include "hedge/normals.h"
+#include "hedge/provenance.h"
 #include "welded_copies.h"
 
 namespace hedge {
@@ -59,7 +60,7 @@ struct Seams {
       if (name == "normal" || name == "quality") continue;
       if (auto* c = m.face_properties().get_channel(name)) faces.push_back(c);
     }
-    flipped = m.face_properties().get<bool>("hedge:flipped");
+    flipped = m.face_properties().get<bool>(provenance::kFlipped);
   }
 
   bool differ(const ChannelArray* c, Index a, Index b) const {

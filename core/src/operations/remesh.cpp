@@ -13,6 +13,7 @@
 
 #include "hedge/distance.h"
 #include "hedge/error.h"
+#include "hedge/provenance.h"
 #include "hedge/report.h"
 #include "parallel.h"
 #include "welded_copies.h"
@@ -249,7 +250,7 @@ void Remesher::classify() {
   kind_.assign(nv, Kind::free);
   degree_.assign(nv, Degree{});
   std::vector<std::uint32_t> copies;
-  const TypedArray<std::uint32_t>* source = mesh_.vertex_properties().get<std::uint32_t>("hedge:source");
+  const TypedArray<std::uint32_t>* source = mesh_.vertex_properties().get<std::uint32_t>(provenance::kVertexSource);
   if (source) {
     std::uint32_t max_source = 0;
     for (std::uint32_t s : source->vector())
