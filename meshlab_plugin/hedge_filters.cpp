@@ -29,10 +29,12 @@ QString filter_info(const Operation& op) {
 
 int filter_class(const Operation& op) {
   // MeshLab's FilterClass bits (interfaces.h in 2020.09, filter_plugin.h in 2022+).
-  if (op.category == "Cleaning") return 0x00002;
-  if (op.category == "Remeshing") return 0x00004;
-  if (op.category == "Smoothing") return 0x00080;
-  if (op.category == "Measure") return 0x10000;
+  switch (op.category) {
+    case Category::cleaning: return 0x00002;
+    case Category::remeshing: return 0x00004;
+    case Category::smoothing: return 0x00080;
+    case Category::measure: return 0x10000;
+  }
   return 0x00000;  // Generic
 }
 
@@ -53,8 +55,8 @@ RichKind rich_kind(const ParamSpec& spec) {
     case ParamType::choice:
       return RichKind::choice;
     case ParamType::real:
-      return std::isfinite(spec.min) && std::isfinite(spec.max) && spec.max - spec.min <= 1e6 ? RichKind::bounded_real
-                                                                                              : RichKind::real;
+      // A slider needs both ends; an open range (a length, a distance) is a plain field.
+      return spec.range.max ? RichKind::bounded_real : RichKind::real;
   }
   return RichKind::real;
 }
@@ -88,22 +90,23 @@ void add_parameters(const Operation& op, RichParameterList& parameters) {
     const QString tooltip = param_tooltip(spec);
     switch (rich_kind(spec)) {
       case RichKind::boolean:
-        parameters.addParam(RichBool(name, spec.default_value != 0, label, tooltip));
+        parameters.addParam(RichBool(name, std::get<bool>(spec.default_value), label, tooltip));
         break;
       case RichKind::integer:
-        parameters.addParam(RichInt(name, int_bound(spec.default_value), label, tooltip));
+        parameters.addParam(RichInt(name, int_bound(double(std::get<std::int64_t>(spec.default_value))), label, tooltip));
         break;
       case RichKind::real:
-        parameters.addParam(RichFloat(name, static_cast<float>(spec.default_value), label, tooltip));
+        parameters.addParam(RichFloat(name, static_cast<float>(std::get<double>(spec.default_value)), label, tooltip));
         break;
       case RichKind::bounded_real:
-        parameters.addParam(RichDynamicFloat(name, static_cast<float>(spec.default_value), static_cast<float>(spec.min),
-                                             static_cast<float>(spec.max), label, tooltip));
+        parameters.addParam(RichDynamicFloat(name, static_cast<float>(std::get<double>(spec.default_value)),
+                                             static_cast<float>(spec.range.min), static_cast<float>(*spec.range.max), label,
+                                             tooltip));
         break;
       case RichKind::choice: {
         QStringList choices;
         for (const std::string& choice : spec.choices) choices << QString::fromStdString(choice);
-        parameters.addParam(RichEnum(name, static_cast<int>(spec.default_value), choices, label, tooltip));
+        parameters.addParam(RichEnum(name, static_cast<int>(spec.default_choice()), choices, label, tooltip));
         break;
       }
     }

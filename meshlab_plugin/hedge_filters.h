@@ -32,8 +32,8 @@ int postcondition_mask(const Operation& op);
 
 //! Which Rich parameter class holds a parameter.
 enum class RichKind { boolean, integer, real, bounded_real, choice };
-//! Reals with a finite range (up to 1e6 wide) get a slider (RichDynamicFloat); reals whose
-//! maximum only means "no limit" (1e30) are plain RichFloat fields.
+//! Reals with both ends get a slider (RichDynamicFloat); reals with no upper limit are plain
+//! RichFloat fields.
 RichKind rich_kind(const ParamSpec& spec);
 //! "RichBool", "RichInt", "RichFloat", "RichDynamicFloat", "RichEnum", as .mlx scripts spell them.
 const char* rich_type_name(RichKind kind);

@@ -35,11 +35,11 @@ def make_property(p):
     if p["type"] == "bool":
         return bpy.props.BoolProperty(name=p["label"], description=help_text, default=bool(p["default"]))
     if p["type"] == "int":
-        lo, hi = max(int(p["min"]), -INT_LIMIT), min(int(p["max"]), INT_LIMIT)
+        lo, hi = max(int(p["min"]), -INT_LIMIT), INT_LIMIT if p["max"] is None else min(int(p["max"]), INT_LIMIT)
         return bpy.props.IntProperty(name=p["label"], description=help_text, default=int(p["default"]),
                                      min=lo, max=hi, soft_min=lo, soft_max=hi)
     if p["type"] == "float":
-        lo, hi = max(p["min"], -FLOAT_LIMIT), min(p["max"], FLOAT_LIMIT)
+        lo, hi = max(p["min"], -FLOAT_LIMIT), FLOAT_LIMIT if p["max"] is None else min(p["max"], FLOAT_LIMIT)
         return bpy.props.FloatProperty(name=p["label"], description=help_text, default=p["default"],
                                        min=lo, max=hi, soft_min=lo, soft_max=hi, precision=4)
     if p["type"] == "enum":

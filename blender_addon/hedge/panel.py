@@ -4,16 +4,12 @@ import bpy
 from . import api
 from .native import native, load_error
 
-CATEGORY_ORDER = ("Measure", "Remeshing", "Smoothing", "Cleaning")
-
-
 def grouped_operations():
     ops = native.catalogue() if native else []
     groups = {}
     for op in ops:
         groups.setdefault(op["category"], []).append(op)
-    order = [c for c in CATEGORY_ORDER if c in groups] + [c for c in groups if c not in CATEGORY_ORDER]
-    return [(c, groups[c]) for c in order]
+    return [(c, groups[c]) for c in native.categories() if c in groups] if native else []
 
 
 def format_value(value):

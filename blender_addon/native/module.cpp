@@ -32,22 +32,10 @@ py::dict param_dict(const ParamSpec& p) {
   d["label"] = p.label;
   d["help"] = p.help;
   d["type"] = param_type_name(p.type);
-  switch (p.type) {
-    case ParamType::boolean:
-      d["default"] = p.default_value != 0;
-      break;
-    case ParamType::integer:
-      d["default"] = static_cast<std::int64_t>(p.default_value);
-      break;
-    case ParamType::real:
-      d["default"] = p.default_value;
-      break;
-    case ParamType::choice:
-      d["default"] = p.choices.at(static_cast<std::size_t>(p.default_value));
-      break;
-  }
-  d["min"] = p.min;
-  d["max"] = p.max;
+  d["default"] = std::visit([](const auto& v) -> py::object { return py::cast(v); }, p.default_value);
+  // Integer and real: no "max" (None) means no upper limit.
+  d["min"] = p.range.min;
+  d["max"] = p.range.max ? py::cast(*p.range.max) : py::none();
   d["choices"] = p.choices;
   d["range_text"] = p.range_text();
   return d;
@@ -59,7 +47,8 @@ py::list catalogue_list() {
     py::dict d;
     d["id"] = op.id;
     d["title"] = op.title;
-    d["category"] = op.category;
+    d["category"] = category_name(op.category);
+    d["results"] = op.results;
     d["help"] = op.help;
     d["changes_mesh"] = op.changes_mesh;
     py::list params;
@@ -388,6 +377,14 @@ PYBIND11_MODULE(_native, m) {
     }
   });
   m.def("catalogue", &catalogue_list, "Every operation with its parameters, in menu order.");
+  m.def(
+      "categories",
+      [] {
+        std::vector<std::string> names;
+        for (Category c : kCategories) names.push_back(category_name(c));
+        return names;
+      },
+      "The categories' names, in the order panels and menus list them.");
   m.def("run", &run, py::arg("operation"), py::arg("mesh"), py::arg("params") = py::dict(),
         py::arg("progress") = py::none(),
         "Runs one operation on a mesh dict (positions, face_sizes, corners, channels); returns "

@@ -25,6 +25,7 @@
 #include "hedge/provenance.h"
 #include "hedge/threads.h"
 #include "parallel.h"
+#include "text.h"
 #include "weld.h"
 
 #ifdef __linux__
@@ -175,9 +176,7 @@ struct ComplexGroup {         // 3+ corner-edges on one vertex pair: a non-manif
   std::uint32_t first, size;  // range in the bucket entries
 };
 
-std::string plural(std::size_t n, const char* one, const char* many) {
-  return std::to_string(n) + " " + (n == 1 ? one : many);
-}
+using detail::plural;
 
 // A corner in the list of its vertex, with the vertices before and after it in its face:
 // the far ends of the edges entering and leaving it.

@@ -14,10 +14,6 @@
 
 namespace hedge {
 
-#define HEDGE_DECLARE_OPERATION(name) Operation name##_operation();
-HEDGE_OPERATIONS(HEDGE_DECLARE_OPERATION)
-#undef HEDGE_DECLARE_OPERATION
-
 const char* param_type_name(ParamType type) {
   switch (type) {
     case ParamType::boolean: return "bool";
@@ -28,19 +24,14 @@ const char* param_type_name(ParamType type) {
   return "unknown";
 }
 
-ParamSpec ParamSpec::boolean(std::string id, std::string label, bool def, std::string help) {
-  return {std::move(id), std::move(label), std::move(help), ParamType::boolean, def ? 1.0 : 0.0, 0, 1, {}};
-}
-ParamSpec ParamSpec::integer(std::string id, std::string label, std::int64_t def, std::int64_t min, std::int64_t max,
-                             std::string help) {
-  return {std::move(id), std::move(label), std::move(help), ParamType::integer, double(def), double(min), double(max), {}};
-}
-ParamSpec ParamSpec::real(std::string id, std::string label, double def, double min, double max, std::string help) {
-  return {std::move(id), std::move(label), std::move(help), ParamType::real, def, min, max, {}};
-}
-ParamSpec ParamSpec::choice(std::string id, std::string label, std::vector<std::string> choices, std::size_t def,
-                            std::string help) {
-  return {std::move(id), std::move(label), std::move(help), ParamType::choice, double(def), 0, 0, std::move(choices)};
+const char* category_name(Category category) {
+  switch (category) {
+    case Category::measure: return "Measure";
+    case Category::cleaning: return "Cleaning";
+    case Category::remeshing: return "Remeshing";
+    case Category::smoothing: return "Smoothing";
+  }
+  return "Other";
 }
 
 namespace {
@@ -51,23 +42,25 @@ std::string number_text(double x) {
 }
 }  // namespace
 
-std::string ParamSpec::default_text() const {
-  switch (type) {
-    case ParamType::boolean: return default_value != 0 ? "true" : "false";
-    case ParamType::integer: return std::to_string(static_cast<std::int64_t>(default_value));
-    case ParamType::real: return number_text(default_value);
-    case ParamType::choice: return choices.at(static_cast<std::size_t>(default_value));
-  }
-  return "";
+std::size_t ParamSpec::default_choice() const {
+  for (std::size_t i = 0; i < choices.size(); ++i)
+    if (Value(choices[i]) == default_value) return i;
+  return 0;
 }
 
+std::string ParamSpec::default_text() const { return value_text(default_value); }
+
 std::string ParamSpec::range_text() const {
+  const bool integral = type == ParamType::integer;
+  auto bound = [&](double x) { return integral ? std::to_string(static_cast<std::int64_t>(x)) : number_text(x); };
   switch (type) {
     case ParamType::boolean: return "true or false";
     case ParamType::integer:
-      return "an integer from " + std::to_string(static_cast<std::int64_t>(min)) + " to " +
-             std::to_string(static_cast<std::int64_t>(max));
-    case ParamType::real: return "a number from " + number_text(min) + " to " + number_text(max);
+    case ParamType::real: {
+      const std::string what = integral ? "an integer " : "a number ";
+      if (!range.max) return what + bound(range.min) + " or more";
+      return what + "from " + bound(range.min) + " to " + bound(*range.max);
+    }
     case ParamType::choice: {
       std::string out = "one of";
       for (std::size_t i = 0; i < choices.size(); ++i) out += (i ? ", " : " ") + choices[i];
@@ -160,32 +153,37 @@ const std::vector<Operation>& catalogue() {
   return operations;
 }
 
+namespace {
+std::string json_list(const std::vector<std::string>& items) {
+  std::string out = "[";
+  for (std::size_t i = 0; i < items.size(); ++i) out += (i ? ", " : "") + json_string(items[i]);
+  return out + "]";
+}
+
+std::string param_json(const ParamSpec& p) {
+  JsonObject out;
+  out.add("id", p.id).add("label", p.label).add("type", param_type_name(p.type)).raw("default", json_value(p.default_value));
+  if (p.type == ParamType::integer) {
+    out.add("min", static_cast<std::int64_t>(p.range.min));
+    out.raw("max", p.range.max ? json_value(static_cast<std::int64_t>(*p.range.max)) : "null");
+  }
+  if (p.type == ParamType::real) out.add("min", p.range.min).raw("max", p.range.max ? json_value(*p.range.max) : "null");
+  return out.raw("choices", json_list(p.choices)).add("range_text", p.range_text()).add("help", p.help).str();
+}
+}  // namespace
+
 std::string catalogue_json() {
   std::string out = "{\"operations\": [";
   bool first_op = true;
   for (const Operation& op : catalogue()) {
-    out += std::string(first_op ? "" : ",") + "\n {\"id\": " + json_string(op.id) +
-           ", \"title\": " + json_string(op.title) + ", \"category\": " + json_string(op.category) +
-           ", \"changes_mesh\": " + (op.changes_mesh ? "true" : "false") + ", \"help\": " + json_string(op.help) +
-           ", \"params\": [";
+    std::string params = "[";
+    for (std::size_t i = 0; i < op.params.size(); ++i) params += (i ? ",\n  " : "\n  ") + param_json(op.params[i]);
+    JsonObject entry;
+    entry.add("id", op.id).add("title", op.title).add("category", category_name(op.category));
+    entry.add("changes_mesh", op.changes_mesh).add("help", op.help).raw("params", params + "]");
+    entry.raw("results", json_list(op.results));
+    out += std::string(first_op ? "" : ",") + "\n " + entry.str();
     first_op = false;
-    for (std::size_t i = 0; i < op.params.size(); ++i) {
-      const ParamSpec& p = op.params[i];
-      Value def = p.type == ParamType::boolean   ? Value(p.default_value != 0)
-                  : p.type == ParamType::integer ? Value(static_cast<std::int64_t>(p.default_value))
-                  : p.type == ParamType::real    ? Value(p.default_value)
-                                                 : Value(p.default_text());
-      out += std::string(i ? "," : "") + "\n  {\"id\": " + json_string(p.id) + ", \"label\": " + json_string(p.label) +
-             ", \"type\": " + json_string(param_type_name(p.type)) + ", \"default\": " + json_value(def);
-      if (p.type == ParamType::integer)
-        out += ", \"min\": " + json_value(static_cast<std::int64_t>(p.min)) +
-               ", \"max\": " + json_value(static_cast<std::int64_t>(p.max));
-      if (p.type == ParamType::real) out += ", \"min\": " + json_value(p.min) + ", \"max\": " + json_value(p.max);
-      out += ", \"choices\": [";
-      for (std::size_t k = 0; k < p.choices.size(); ++k) out += (k ? ", " : "") + json_string(p.choices[k]);
-      out += "], \"range_text\": " + json_string(p.range_text()) + ", \"help\": " + json_string(p.help) + "}";
-    }
-    out += "]}";
   }
   return out + "\n]}\n";
 }
@@ -217,7 +215,7 @@ Value check_value(const Operation& op, const ParamSpec& p, const Value& value) {
       else if (const auto* pd = std::get_if<double>(&value); pd && std::isfinite(*pd) && std::floor(*pd) == *pd && std::fabs(*pd) < 9e15)
         i = static_cast<std::int64_t>(*pd);
       else refuse(op, p, text);
-      if (double(i) < p.min || double(i) > p.max) refuse(op, p, text);
+      if (!p.range.contains(double(i))) refuse(op, p, text);
       return i;
     }
     case ParamType::real: {
@@ -225,7 +223,7 @@ Value check_value(const Operation& op, const ParamSpec& p, const Value& value) {
       if (const auto* pd = std::get_if<double>(&value)) d = *pd;
       else if (const auto* pi = std::get_if<std::int64_t>(&value)) d = double(*pi);
       else refuse(op, p, text);
-      if (!std::isfinite(d) || d < p.min || d > p.max) refuse(op, p, text);
+      if (!std::isfinite(d) || !p.range.contains(d)) refuse(op, p, text);
       return d;
     }
     case ParamType::choice: {
@@ -274,7 +272,7 @@ ParamValues resolve(const Operation& op, const Given& given, Convert convert) {
   ParamValues values;
   for (const auto& p : op.params) {
     auto it = given.find(p.id);
-    Value v = it == given.end() ? parse_text(op, p, p.default_text()) : convert(p, it->second);
+    Value v = it == given.end() ? p.default_value : convert(p, it->second);
     values.set(p.id, check_value(op, p, v));
   }
   return values;

@@ -15,6 +15,7 @@
 
 #include "hedge/error.h"
 #include "hedge/soup.h"
+#include "text.h"
 
 namespace hedge::io_detail {
 
@@ -28,11 +29,7 @@ std::string quote(std::string_view token, bool at_end_of_file = false);
 //! topology alone, but a bad index or a NaN should still be reported against the file.
 void check_soup(const Soup& soup, const std::string& name);
 
-//! "1 face", "2 faces"; irregular words give their plural: plural(n, "vertex", "vertices").
-inline std::string plural(std::uint64_t n, const char* word, const char* words = nullptr) {
-  if (n == 1) return "1 " + std::string(word);
-  return std::to_string(n) + " " + (words ? std::string(words) : std::string(word) + "s");
-}
+using detail::plural;
 
 //! Parses the whole token as a T (integer or floating point). Accepts a leading '+', which
 //! std::from_chars does not. Floating-point values too small or too large for T become

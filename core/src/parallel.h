@@ -11,6 +11,18 @@
 
 namespace hedge {
 
+namespace testing {
+//! For tests only: the smallest range of elements a parallel part gives a thread (0, the
+//! default: each part's own tuned value), so that small meshes take the multi-threaded
+//! paths.
+void set_parallel_grain(std::size_t elements);
+std::size_t parallel_grain();
+//! How many times a parallel part has split its work across two or more threads, so that
+//! tests can tell the multi-threaded paths really ran.
+std::size_t parallel_splits();
+void count_parallel_split();
+}  // namespace testing
+
 //! Runs fn(begin, end) over [0, n) split across up to `threads` threads (0: thread_count());
 //! ranges below `grain` elements per thread stay on the calling thread, where a thread would
 //! cost more than it saves. The first exception thrown by any part is rethrown after all parts

@@ -4,6 +4,8 @@
 #include <atomic>
 #include <thread>
 
+#include "parallel.h"
+
 namespace hedge {
 namespace {
 std::atomic<unsigned> g_thread_count{0};

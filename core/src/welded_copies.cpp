@@ -6,7 +6,7 @@
 namespace hedge::detail {
 
 WeldedCopies::WeldedCopies(const Mesh& mesh) {
-  const auto* source = mesh.vertex_properties().get<std::uint32_t>("hedge:source");
+  const auto* source = mesh.vertex_properties().get<std::uint32_t>(provenance::kVertexSource);
   if (!source) return;
   std::vector<std::pair<std::uint32_t, Index>> by_source;
   for (Vertex v : mesh.vertices())

@@ -269,7 +269,7 @@ int list(const std::vector<std::string>& args) {
     return 0;
   }
   for (const auto& op : catalogue()) {
-    std::printf("%-14s %s (%s)\n", op.id.c_str(), op.title.c_str(), op.category.c_str());
+    std::printf("%-14s %s (%s)\n", op.id.c_str(), op.title.c_str(), category_name(op.category));
     for (const auto& p : op.params) print_param(p);
   }
   return 0;

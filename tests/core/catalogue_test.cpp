@@ -5,10 +5,12 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <regex>
 #include <set>
 
 #include "hedge/error.h"
+#include "operations/binding.h"
 
 namespace hedge {
 namespace {
@@ -30,7 +32,7 @@ TEST(Catalogue, EveryOperationIsWellDeclared) {
     EXPECT_TRUE(std::regex_match(op.id, snake)) << op.id;
     EXPECT_TRUE(ids.insert(op.id).second) << "duplicate " << op.id;
     EXPECT_FALSE(op.title.empty()) << op.id;
-    EXPECT_FALSE(op.category.empty()) << op.id;
+    EXPECT_STRNE(category_name(op.category), "Other") << op.id;
     EXPECT_GT(op.help.size(), 40u) << op.id << " needs real help text";
     ASSERT_TRUE(op.run) << op.id;
     std::set<std::string> params;
@@ -39,13 +41,18 @@ TEST(Catalogue, EveryOperationIsWellDeclared) {
       EXPECT_TRUE(params.insert(p.id).second) << op.id << " repeats " << p.id;
       EXPECT_FALSE(p.help.empty()) << op.id << "." << p.id;
       EXPECT_FALSE(p.label.empty()) << op.id << "." << p.id;
-      if (p.type == ParamType::integer || p.type == ParamType::real) {
-        EXPECT_LE(p.min, p.default_value) << op.id << "." << p.id;
-        EXPECT_LE(p.default_value, p.max) << op.id << "." << p.id;
+      if (p.type == ParamType::integer) {
+        EXPECT_TRUE(p.range.contains(double(std::get<std::int64_t>(p.default_value)))) << op.id << "." << p.id;
+      }
+      if (p.type == ParamType::real) {
+        EXPECT_TRUE(p.range.contains(std::get<double>(p.default_value))) << op.id << "." << p.id;
       }
       if (p.type == ParamType::choice) {
         EXPECT_FALSE(p.choices.empty());
-        EXPECT_LT(p.default_value, double(p.choices.size()));
+        EXPECT_EQ(p.choices.at(p.default_choice()), std::get<std::string>(p.default_value)) << op.id << "." << p.id;
+      }
+      if (p.type == ParamType::boolean) {
+        EXPECT_TRUE(std::holds_alternative<bool>(p.default_value)) << op.id << "." << p.id;
       }
     }
     // Defaults always resolve.
@@ -73,12 +80,17 @@ TEST(Catalogue, ParametersAreChecked) {
       std::vector<std::string> bad;
       switch (p.type) {
         case ParamType::boolean: bad = {"maybe", "2"}; break;
-        case ParamType::integer: bad = {"1.5", "abc", std::to_string(static_cast<long long>(p.max) + 1), "-999999999999"}; break;
-        case ParamType::real: bad = {"abc", "nan", "1e400"}; if (p.min > -1e300) bad.push_back("-1e299"); break;
+        case ParamType::integer:
+          bad = {"1.5", "abc", "-999999999999"};
+          if (p.range.max) bad.push_back(std::to_string(static_cast<long long>(*p.range.max) + 1));
+          break;
+        case ParamType::real:
+          bad = {"abc", "nan", "1e400", "-1e299"};
+          if (p.range.max) bad.push_back(value_text(std::nextafter(*p.range.max, 1e300)));
+          break;
         case ParamType::choice: bad = {"no_such_choice"}; break;
       }
       for (const auto& value : bad) {
-        if (p.type == ParamType::integer && value == std::to_string(static_cast<long long>(p.max) + 1) && p.max >= 9e15) continue;
         try {
           resolve_params(op, std::map<std::string, std::string>{{p.id, value}});
           ADD_FAILURE() << op.id << "." << p.id << " accepted " << value;
@@ -93,11 +105,55 @@ TEST(Catalogue, ParametersAreChecked) {
   }
 }
 
+namespace demo {
+enum class Mode { a, b };
+const char* mode_name(Mode m) { return m == Mode::a ? "a" : "b"; }
+struct Options {
+  double ratio = 0.5;
+  int count = 3;
+  bool flag = true;
+  Mode mode = Mode::b;
+  std::size_t limit = 7;
+};
+struct Report {
+  std::size_t doubled = 0;
+  std::string mode;
+};
+Operation operation() {
+  auto run = [](Mesh&, const Options& o, Progress&) { return Report{2 * o.limit, mode_name(o.mode)}; };
+  return Binding<Options, Report>("demo", "Demo", Category::measure, "a demo", run)
+      .option(&Options::ratio, "ratio", "Ratio", between(0, 1), "a ratio")
+      .option(&Options::count, "count", "Count", between(1, 10), "n")
+      .option(&Options::flag, "flag", "Flag", "f")
+      .choice(&Options::mode, "mode", "Mode", {Mode::a, Mode::b}, mode_name, "m")
+      .option(&Options::limit, "limit", "Limit", at_least(0), "no upper limit")
+      .result(&Report::doubled, "doubled")
+      .result(&Report::mode, "mode");
+}
+}  // namespace demo
+
+// The binding: types and defaults come from the options struct, ranges from the binding.
+TEST(Catalogue, BindingTakesTypesAndDefaultsFromTheOptions) {
+  const Operation op = demo::operation();
+  ASSERT_EQ(op.params.size(), 5u);
+  EXPECT_EQ(op.params[0].type, ParamType::real);
+  EXPECT_EQ(op.params[0].default_value, Value(0.5));
+  EXPECT_EQ(op.params[1].type, ParamType::integer);
+  EXPECT_EQ(op.params[1].default_value, Value(std::int64_t(3)));
+  EXPECT_EQ(op.params[2].default_value, Value(true));
+  EXPECT_EQ(op.params[3].default_value, Value(std::string("b")));
+  EXPECT_EQ(op.params[3].default_choice(), 1u);
+  EXPECT_FALSE(op.params[4].range.max);
+  EXPECT_EQ(op.params[4].range_text(), "an integer 0 or more");
+  EXPECT_EQ(op.results, (std::vector<std::string>{"doubled", "mode"}));
+  Mesh mesh;
+  ParamValues values = resolve_params(op, std::map<std::string, std::string>{{"limit", "99999999999"}, {"mode", "a"}});
+  OperationReport report = op.run(mesh, values, Progress::none());
+  EXPECT_EQ(report.to_json(), "{\"doubled\": 199999999998, \"mode\": \"a\", \"messages\": []}");
+}
+
 TEST(Catalogue, TypedValuesResolve) {
-  Operation op;
-  op.id = "demo";
-  op.params = {ParamSpec::real("ratio", "Ratio", 0.5, 0, 1, "a ratio"), ParamSpec::integer("count", "Count", 3, 1, 10, "n"),
-               ParamSpec::boolean("flag", "Flag", true, "f"), ParamSpec::choice("mode", "Mode", {"a", "b"}, 1, "m")};
+  const Operation op = demo::operation();
   ParamValues v = resolve_params(op, std::map<std::string, Value>{{"ratio", std::int64_t(1)}, {"mode", std::string("a")}});
   EXPECT_EQ(v.get_real("ratio"), 1.0);
   EXPECT_EQ(v.get_int("count"), 3);

@@ -607,7 +607,7 @@ TEST(Decimate, InputUntouchedOnFailureAndCancel) {
 TEST(Decimate, ThroughTheCatalogue) {
   const Operation& op = find_operation("decimate");
   EXPECT_EQ(op.title, "Decimate");
-  EXPECT_EQ(op.category, "Remeshing");
+  EXPECT_EQ(op.category, Category::remeshing);
   const Soup input = uv_cylinder();
   const ParamValues params = resolve_params(op, std::map<std::string, std::string>{{"target_faces", "500"}});
   const RunResult r = run_operation(op, input, params, Progress::none());

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "hedge/build.h"
+#include "hedge/catalogue.h"
 #include "hedge/error.h"
 #include "hedge/io.h"
 #include "hedge/report.h"
@@ -245,10 +246,10 @@ TEST(Delaunay, FlipBudgetIsReported) {
 
 TEST(Delaunay, CatalogueEntry) {
   const Operation& op = find_operation("make_delaunay");
-  EXPECT_EQ(op.category, "Cleaning");
+  EXPECT_EQ(op.category, Category::cleaning);
   ASSERT_NE(op.find_param("feature_angle"), nullptr);
-  EXPECT_EQ(op.find_param("feature_angle")->default_value, 30);
-  EXPECT_EQ(op.find_param("feature_angle")->max, 180);
+  EXPECT_EQ(op.find_param("feature_angle")->default_value, Value(30.0));
+  EXPECT_EQ(op.find_param("feature_angle")->range.max, 180);
   Mesh mesh = random_points(100, 6);
   OperationReport r = op.run(mesh, resolve_params(op, std::map<std::string, std::string>{}), Progress::none());
   expect_valid(mesh);

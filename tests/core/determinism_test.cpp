@@ -17,6 +17,7 @@
 #include "hedge/io.h"
 #include "hedge/progress.h"
 #include "hedge/threads.h"
+#include "parallel.h"
 
 namespace hedge {
 namespace {

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "hedge/build.h"
+#include "hedge/catalogue.h"
 #include "hedge/io.h"
 #include "hedge/provenance.h"
 #include "hedge/repair.h"
@@ -612,7 +613,7 @@ TEST(FillHoles, DragonEveryHoleClosed) {
 
 TEST(FillHoles, OperationRunsFromTheCatalogue) {
   const Operation& op = find_operation("fill_holes");
-  EXPECT_EQ(op.category, "Cleaning");
+  EXPECT_EQ(op.category, Category::cleaning);
   RunResult run =
       run_operation(op, grid_with_hole(10, 2.5),
                     resolve_params(op, std::map<std::string, std::string>{{"max_hole_edges", "30"}}), Progress::none());

@@ -13,6 +13,7 @@
 #include <numbers>
 
 #include "hedge/build.h"
+#include "hedge/catalogue.h"
 #include "hedge/distance.h"
 #include "hedge/io.h"
 #include "hedge/report.h"
@@ -470,15 +471,15 @@ TEST(Remesh, CoarseInputRefinesEvenly) {
 TEST(Remesh, CatalogueEntry) {
   const Operation& op = find_operation("remesh");
   EXPECT_EQ(op.title, "Isotropic Remesh");
-  EXPECT_EQ(op.category, "Remeshing");
+  EXPECT_EQ(op.category, Category::remeshing);
   ASSERT_EQ(op.params.size(), 5u);
   EXPECT_EQ(op.params[0].id, "target_edge_length");
   EXPECT_EQ(op.params[1].id, "iterations");
   EXPECT_EQ(op.params[2].id, "feature_angle");
   EXPECT_EQ(op.params[3].id, "preserve_boundary");
   EXPECT_EQ(op.params[4].id, "adaptive");
-  EXPECT_EQ(op.params[1].default_value, 5);
-  EXPECT_EQ(op.params[2].default_value, 45);
+  EXPECT_EQ(op.params[1].default_value, Value(std::int64_t(5)));
+  EXPECT_EQ(op.params[2].default_value, Value(45.0));
   RunResult r =
       run_operation(op, sphere_soup(10, 12, 1.0),
                     resolve_params(op, std::map<std::string, std::string>{{"iterations", "3"}}), Progress::none());

@@ -10,6 +10,7 @@
 #include <map>
 
 #include "hedge/build.h"
+#include "hedge/catalogue.h"
 #include "hedge/io.h"
 #include "hedge/report.h"
 #include "hedge/validate.h"

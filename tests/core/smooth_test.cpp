@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "hedge/build.h"
+#include "hedge/catalogue.h"
 #include "hedge/error.h"
 #include "hedge/io.h"
 #include "hedge/report.h"
@@ -347,13 +348,13 @@ TEST(Smooth, SkipsDeletedAndIsolatedVertices) {
 
 TEST(Smooth, CatalogueEntry) {
   const Operation& op = find_operation("smooth");
-  EXPECT_EQ(op.category, "Smoothing");
+  EXPECT_EQ(op.category, Category::smoothing);
   EXPECT_EQ(op.find_param("method")->choices, (std::vector<std::string>{"uniform", "cotangent", "taubin"}));
-  EXPECT_EQ(op.find_param("method")->default_value, 0);
-  EXPECT_EQ(op.find_param("iterations")->default_value, 10);
-  EXPECT_EQ(op.find_param("iterations")->max, 1000);
-  EXPECT_EQ(op.find_param("strength")->default_value, 0.5);
-  EXPECT_EQ(op.find_param("preserve_boundary")->default_value, 1);
+  EXPECT_EQ(op.find_param("method")->default_value, Value(std::string("uniform")));
+  EXPECT_EQ(op.find_param("iterations")->default_value, Value(std::int64_t(10)));
+  EXPECT_EQ(op.find_param("iterations")->range.max, 1000);
+  EXPECT_EQ(op.find_param("strength")->default_value, Value(0.5));
+  EXPECT_EQ(op.find_param("preserve_boundary")->default_value, Value(true));
   Mesh mesh = sphere(2);
   add_radial_noise(mesh, 0.05f);
   OperationReport r =

@@ -26,6 +26,7 @@
 #include "hedge/threads.h"
 #include "hedge/topology.h"
 #include "hedge/validate.h"
+#include "parallel.h"
 #include "test_meshes.h"
 
 namespace {
@@ -624,10 +625,10 @@ TEST(Subdivide, SkipsDeletedElementsAndKeepsIsolatedVertices) {
 
 TEST(Subdivide, CatalogueEntry) {
   const Operation& op = find_operation("subdivide");
-  EXPECT_EQ(op.category, "Remeshing");
+  EXPECT_EQ(op.category, Category::remeshing);
   ASSERT_NE(op.find_param("scheme"), nullptr);
   EXPECT_EQ(op.find_param("scheme")->choices, (std::vector<std::string>{"loop", "catmull_clark", "sqrt3", "midpoint"}));
-  EXPECT_EQ(op.find_param("iterations")->default_value, 1);
+  EXPECT_EQ(op.find_param("iterations")->default_value, Value(std::int64_t(1)));
   Mesh mesh = unit_cube();
   OperationReport r = op.run(
       mesh, resolve_params(op, std::map<std::string, std::string>{{"scheme", "catmull_clark"}, {"iterations", "2"}}),
@@ -1054,9 +1055,9 @@ TEST(SubdivideCreases, CatalogueParameter) {
   const ParamSpec* p = op.find_param("crease_angle");
   ASSERT_NE(p, nullptr);
   EXPECT_EQ(p->type, ParamType::real);
-  EXPECT_EQ(p->default_value, 180);
-  EXPECT_EQ(p->min, 0);
-  EXPECT_EQ(p->max, 180);
+  EXPECT_EQ(p->default_value, Value(180.0));
+  EXPECT_EQ(p->range.min, 0);
+  EXPECT_EQ(p->range.max, 180);
   EXPECT_FALSE(p->help.empty());
   Mesh mesh = unit_cube();
   OperationReport r = op.run(

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "hedge/build.h"
+#include "hedge/catalogue.h"
 #include "hedge/error.h"
 #include "hedge/io.h"
 #include "hedge/report.h"
@@ -296,7 +297,7 @@ TEST(Triangulate, CancellingLeavesTheMesh) {
 TEST(Triangulate, CatalogueEntry) {
   const Operation& op = find_operation("triangulate");
   EXPECT_EQ(op.find_param("method")->choices, (std::vector<std::string>{"min_area", "ear_clipping"}));
-  EXPECT_EQ(op.find_param("method")->default_value, 0);
+  EXPECT_EQ(op.find_param("method")->default_value, Value(std::string("min_area")));
   Mesh mesh = polygon(star(6, 0.4f, 1.0f));
   OperationReport r = op.run(mesh, resolve_params(op, std::map<std::string, std::string>{}), Progress::none());
   expect_valid(mesh);

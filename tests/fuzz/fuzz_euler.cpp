@@ -348,15 +348,18 @@ hedge::ParamValues draw_params(FuzzedDataProvider& in, const hedge::Operation& o
         break;
       case hedge::ParamType::integer: {
         // Small values only: iteration counts and sizes multiply the work.
-        auto lo = static_cast<std::int64_t>(p.min);
-        auto hi = std::min<std::int64_t>(static_cast<std::int64_t>(p.max), lo + (p.id == "iterations" ? 1 : 64));
+        auto lo = static_cast<std::int64_t>(p.range.min);
+        auto hi = lo + (p.id == "iterations" ? 1 : 64);
+        if (p.range.max) hi = std::min<std::int64_t>(static_cast<std::int64_t>(*p.range.max), hi);
         given[p.id] = in.ConsumeIntegralInRange<std::int64_t>(lo, hi);
         break;
       }
       case hedge::ParamType::real: {
-        double hi = p.max > 1e3 ? 4.0 : p.max;  // lengths and distances: the meshes are a few units wide
-        double lo = p.max > 1e3 ? std::max(p.min, 0.25) : p.min;
-        if (p.max > 1e3 && in.ConsumeBool()) lo = p.min, hi = p.min;  // 0 = automatic
+        // Unbounded ones are lengths and distances: the meshes are a few units wide.
+        const bool unbounded = !p.range.max;
+        double hi = unbounded ? 4.0 : *p.range.max;
+        double lo = unbounded ? std::max(p.range.min, 0.25) : p.range.min;
+        if (unbounded && in.ConsumeBool()) lo = p.range.min, hi = p.range.min;  // 0 = automatic
         given[p.id] = lo + (hi - lo) * in.ConsumeProbability<double>();
         break;
       }

@@ -8,13 +8,18 @@ import math
 def cases(p):
     """[(value, accepted)] for parameter `p` (a catalogue dict of `hedge list --json`):
     integers and reals at min and max and the nearest values beyond, every choice of an enum
-    and one that is not, both booleans."""
+    and one that is not, both booleans. A parameter with no upper limit (max None) takes a
+    large value instead of its max."""
     if p["type"] == "int":
+        if p["max"] is None:
+            return [(p["min"], True), (2**31 - 1, True), (p["min"] - 1, False)]
         return [(p["min"], True), (p["max"], True), (p["min"] - 1, False), (p["max"] + 1, False)]
     if p["type"] == "float":
-        return [(float(p["min"]), True), (float(p["max"]), True),
-                (math.nextafter(float(p["min"]), -math.inf), False), (math.nextafter(float(p["max"]), math.inf), False),
-                (math.nan, False), (math.inf, False)]
+        below = [(float(p["min"]), True), (math.nextafter(float(p["min"]), -math.inf), False),
+                 (math.nan, False), (math.inf, False)]
+        if p["max"] is None:
+            return below + [(1e30, True)]
+        return below + [(float(p["max"]), True), (math.nextafter(float(p["max"]), math.inf), False)]
     if p["type"] == "enum":
         return [(c, True) for c in p["choices"]] + [("no_such_" + p["id"], False)]
     if p["type"] == "bool":

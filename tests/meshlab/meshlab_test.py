@@ -346,8 +346,6 @@ def default_value(p):
         return bool(p["default"])
     if p["type"] == "int":
         return int(p["default"])
-    if p["type"] == "enum":
-        return p["choices"][int(p["default"])]
     return p["default"]
 
 

@@ -36,7 +36,7 @@ def out_of_range(p):
         return len(p["choices"]) + 3
     if p["type"] == "bool":
         return None
-    if p["max"] < 2147483647 and p["max"] < 1e29:
+    if p["max"] is not None and p["max"] < 2147483647:
         return p["max"] + (1 if p["type"] == "int" else 0.5)
     if p["min"] > -2147483648:
         return p["min"] - 1

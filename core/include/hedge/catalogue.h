@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <functional>
 #include <map>
+#include <optional>
 #include <string>
 #include <type_traits>
 #include <variant>
@@ -18,32 +19,49 @@
 
 namespace hedge {
 
+using Value = std::variant<bool, std::int64_t, double, std::string>;
+std::string value_text(const Value& value);
+
 enum class ParamType { boolean, integer, real, choice };
 const char* param_type_name(ParamType type);
 
+//! Where operations appear: MeshLab's filter classes, Blender's panel groups, `hedge list`.
+enum class Category { measure, remeshing, smoothing, cleaning };
+//! Every category, in the order front ends list them.
+inline constexpr Category kCategories[] = {Category::measure, Category::remeshing, Category::smoothing,
+                                           Category::cleaning};
+//! "Measure", "Remeshing", "Smoothing", "Cleaning".
+const char* category_name(Category category);
+
+//! The values an integer or real parameter takes: min to max, both included. No max means
+//! no upper limit (a length, a count), which front ends show as an open field, not a slider.
+struct Range {
+  double min = 0;
+  std::optional<double> max;
+  bool contains(double x) const { return x >= min && (!max || x <= *max); }
+};
+inline Range between(double min, double max) { return {min, max}; }
+inline Range at_least(double min) { return {min, std::nullopt}; }
+
 //! One parameter. Ids are snake_case and identical in every front end (CLI flags use
-//! dashes: --target-ratio).
+//! dashes: --target-ratio). Operations declare them by binding an options field
+//! (src/operations/binding.h), which gives the type and the default.
 struct ParamSpec {
   std::string id;
   std::string label;  //!< short name for UIs, e.g. "Target ratio"
   std::string help;
   ParamType type = ParamType::real;
-  double default_value = 0;  //!< bool: 0/1; choice: index into choices
-  double min = 0, max = 0;   //!< inclusive range for integer and real
+  Value default_value;  //!< of the parameter's type; a choice's default is its name
+  Range range;          //!< integer and real
   std::vector<std::string> choices;  //!< for choice
 
-  static ParamSpec boolean(std::string id, std::string label, bool def, std::string help);
-  static ParamSpec integer(std::string id, std::string label, std::int64_t def, std::int64_t min, std::int64_t max, std::string help);
-  static ParamSpec real(std::string id, std::string label, double def, double min, double max, std::string help);
-  static ParamSpec choice(std::string id, std::string label, std::vector<std::string> choices, std::size_t def, std::string help);
+  //! The default's index in choices (choice parameters).
+  std::size_t default_choice() const;
   //! The default as text, as a user would type it.
   std::string default_text() const;
   //! "0 to 1", "one of loop, catmull_clark", "true or false".
   std::string range_text() const;
 };
-
-using Value = std::variant<bool, std::int64_t, double, std::string>;
-std::string value_text(const Value& value);
 
 //! JSON text of a string (quoted and escaped) and of a value (a non-finite number is null).
 std::string json_string(const std::string& s);
@@ -103,9 +121,11 @@ struct OperationReport {
 struct Operation {
   std::string id;        //!< snake_case: "decimate"
   std::string title;     //!< "Decimate": MeshLab shows "Hedge: Decimate"
-  std::string category;  //!< "Remeshing", "Smoothing", "Cleaning", "Measure"
+  Category category = Category::measure;
   std::string help;      //!< what it does, when to use it, the paper it follows
   std::vector<ParamSpec> params;
+  //! The report's keys, in order (some appear only when they apply).
+  std::vector<std::string> results;
   bool changes_mesh = true;  //!< false for report-only operations
   std::function<OperationReport(Mesh&, const ParamValues&, Progress&)> run;
 

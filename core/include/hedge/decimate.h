@@ -6,7 +6,6 @@
 #include <cstdint>
 #include <string>
 
-#include "hedge/catalogue.h"
 #include "hedge/mesh.h"
 #include "hedge/progress.h"
 
@@ -71,8 +70,5 @@ struct DecimateReport {
 //! Throws Error on bad options, leaving the mesh untouched; when cancelled through
 //! `progress` the mesh is restored as it was.
 DecimateReport decimate(Mesh& mesh, const DecimateOptions& options, Progress& progress = Progress::none());
-
-//! The catalogue entry.
-Operation decimate_operation();
 
 }  // namespace hedge

@@ -4,7 +4,6 @@
 
 #include <cstddef>
 
-#include "hedge/catalogue.h"
 #include "hedge/mesh.h"
 #include "hedge/progress.h"
 
@@ -70,8 +69,5 @@ DelaunayCensus delaunay_census(const Mesh& mesh, const DelaunayOptions& options 
 //! Throws Error, leaving the mesh untouched, when the mesh has faces other than triangles;
 //! Cancelled through progress likewise (the flips run on a copy).
 DelaunayReport make_delaunay(Mesh& mesh, const DelaunayOptions& options = {}, Progress& progress = Progress::none());
-
-//! The catalogue entry "make_delaunay" (parameter feature_angle).
-Operation make_delaunay_operation();
 
 }  // namespace hedge

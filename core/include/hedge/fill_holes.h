@@ -6,7 +6,6 @@
 #include <string>
 #include <vector>
 
-#include "hedge/catalogue.h"
 #include "hedge/mesh.h"
 #include "hedge/progress.h"
 
@@ -66,7 +65,5 @@ struct FillHolesReport {
 //! border are carried into the patch and interpolated at new vertices.
 //! Throws Error (or Cancelled) leaving `mesh` unchanged.
 FillHolesReport fill_holes(Mesh& mesh, const FillHolesOptions& options = {}, Progress& progress = Progress::none());
-
-Operation fill_holes_operation();
 
 }  // namespace hedge

@@ -4,7 +4,6 @@
 
 #include <cstddef>
 
-#include "hedge/catalogue.h"
 #include "hedge/mesh.h"
 #include "hedge/progress.h"
 
@@ -49,7 +48,5 @@ struct RemeshReport {
 //! Throws Error on bad options and on targets forecast above options.max_faces (and
 //! Cancelled when progress asks), leaving the mesh as it was.
 RemeshReport remesh(Mesh& mesh, const RemeshOptions& options, Progress& progress = Progress::none());
-
-Operation remesh_operation();
 
 }  // namespace hedge

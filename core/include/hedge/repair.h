@@ -6,7 +6,6 @@
 #include <string>
 #include <vector>
 
-#include "hedge/catalogue.h"
 #include "hedge/mesh.h"
 #include "hedge/progress.h"
 
@@ -72,7 +71,5 @@ struct RepairReport {
 //! provenance; skipped faces at the very end of the soup are not counted.
 //! Throws Error (or Cancelled) leaving `mesh` unchanged.
 RepairReport repair(Mesh& mesh, const RepairOptions& options = {}, Progress& progress = Progress::none());
-
-Operation repair_operation();
 
 }  // namespace hedge

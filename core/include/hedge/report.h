@@ -3,7 +3,7 @@
 
 #include <cstddef>
 
-#include "hedge/catalogue.h"
+#include "hedge/geometry.h"
 #include "hedge/mesh.h"
 #include "hedge/topology.h"
 
@@ -26,12 +26,5 @@ struct MeshStatistics {
 };
 
 MeshStatistics mesh_statistics(const Mesh& mesh);
-
-//! Angles, quality, area of a triangle (double precision).
-double triangle_quality(const Vec3d& a, const Vec3d& b, const Vec3d& c);
-double triangle_min_angle(const Vec3d& a, const Vec3d& b, const Vec3d& c);
-
-//! Adds the statistics to a report as entries.
-void add_statistics(const MeshStatistics& s, OperationReport& report);
 
 }  // namespace hedge

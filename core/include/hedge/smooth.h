@@ -5,7 +5,6 @@
 #include <cstddef>
 #include <string>
 
-#include "hedge/catalogue.h"
 #include "hedge/mesh.h"
 #include "hedge/progress.h"
 
@@ -55,8 +54,5 @@ struct SmoothReport {
 //! Throws Error for strength outside (0, 1] or iterations < 1; Cancelled through progress;
 //! either way the mesh is left untouched.
 SmoothReport smooth(Mesh& mesh, const SmoothOptions& options, Progress& progress = Progress::none());
-
-//! The catalogue entry "smooth" (parameters method, iterations, strength, preserve_boundary).
-Operation smooth_operation();
 
 }  // namespace hedge

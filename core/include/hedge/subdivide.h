@@ -5,7 +5,6 @@
 #include <cstddef>
 #include <string>
 
-#include "hedge/catalogue.h"
 #include "hedge/mesh.h"
 #include "hedge/progress.h"
 
@@ -33,6 +32,7 @@ struct SubdivideOptions {
 };
 
 struct SubdivideReport {
+  std::size_t faces_before = 0;                    //!< of the input
   std::size_t vertices = 0, edges = 0, faces = 0;  //!< of the result
   int iterations = 0;
   std::size_t crease_edges = 0;  //!< interior edges of the input found sharper than crease_angle
@@ -87,8 +87,5 @@ std::size_t subdivided_face_count(const Mesh& mesh, const SubdivideOptions& opti
 //! options.max_faces, crease_angle outside 0 to 180; Cancelled
 //! through progress likewise.
 SubdivideReport subdivide(Mesh& mesh, const SubdivideOptions& options, Progress& progress = Progress::none());
-
-//! The catalogue entry "subdivide" (parameters scheme, iterations, crease_angle).
-Operation subdivide_operation();
 
 }  // namespace hedge

@@ -18,16 +18,4 @@ unsigned thread_count();
 //! `requested` itself, or thread_count() when it is 0.
 unsigned resolve_thread_count(unsigned requested);
 
-namespace testing {
-//! For tests only: the smallest range of elements a parallel part gives a thread (0, the
-//! default: each part's own tuned value), so that small meshes take the multi-threaded
-//! paths.
-void set_parallel_grain(std::size_t elements);
-std::size_t parallel_grain();
-//! How many times a parallel part has split its work across two or more threads, so that
-//! tests can tell the multi-threaded paths really ran.
-std::size_t parallel_splits();
-void count_parallel_split();
-}  // namespace testing
-
 }  // namespace hedge

@@ -5,7 +5,6 @@
 #include <cstddef>
 #include <string>
 
-#include "hedge/catalogue.h"
 #include "hedge/mesh.h"
 #include "hedge/progress.h"
 
@@ -58,8 +57,5 @@ struct TriangulateReport {
 //! Runs on a copy when there is anything to do, so an error or a cancellation leaves the
 //! mesh as it was.
 TriangulateReport triangulate(Mesh& mesh, const TriangulateOptions& options, Progress& progress = Progress::none());
-
-//! The catalogue entry "triangulate" (parameter method).
-Operation triangulate_operation();
 
 }  // namespace hedge

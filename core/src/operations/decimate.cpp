@@ -14,7 +14,8 @@
 
 #include "hedge/distance.h"
 #include "hedge/error.h"
-#include "hedge/report.h"
+#include "hedge/geometry.h"
+#include "binding.h"
 #include "parallel.h"
 #include "welded_copies.h"
 #ifdef HEDGE_DECIMATE_DEBUG
@@ -1240,11 +1241,7 @@ DecimateReport decimate(Mesh& mesh, const DecimateOptions& options, Progress& pr
 }
 
 Operation decimate_operation() {
-  Operation op;
-  op.id = "decimate";
-  op.title = "Decimate";
-  op.category = "Remeshing";
-  op.help =
+  const char* help =
       "Reduces the number of triangles while keeping the shape: repeatedly collapses the edge whose removal "
       "changes the surface least, measured by quadric error metrics (Garland and Heckbert, SIGGRAPH 1997), and "
       "puts the merged vertex where that error is smallest. Use it to make scans and dense meshes light enough to "
@@ -1255,52 +1252,38 @@ Operation decimate_operation() {
       "of small pieces and slits may stop above its target. Attributes do not weigh in the error (a UV seam or "
       "colour edge is kept by the seam rules, not by the metric), and creases get no special treatment beyond "
       "what the quadrics give them.";
-  op.params = {
-      ParamSpec::integer("target_faces", "Target faces", 0, 0, 2147483647,
-                         "Number of triangles to reach; 0 uses the target ratio instead. On a closed surface an "
-                         "odd count stops one above it, since a collapse there removes two triangles."),
-      ParamSpec::real("target_ratio", "Target ratio", 0.5, 0, 1,
-                      "Fraction of the triangles to keep, when target faces is 0."),
-      ParamSpec::real("max_error", "Max error", 0, 0, 1,
-                      "Never collapse an edge whose error exceeds this fraction of the bounding-box diagonal "
-                      "(it may then stop above the target); 0 = no limit."),
-      ParamSpec::boolean("preserve_boundary", "Preserve boundary", true,
-                         "Boundary vertices stay where they are; boundary edges only collapse along the boundary."),
-      ParamSpec::boolean("preserve_uv_seams", "Preserve UV seams", true,
-                         "Keep per-corner attributes (UVs, corner normals, colours) continuous: vertices on a seam "
-                         "only move along it, seam ends and junctions stay."),
-      ParamSpec::boolean("prevent_flips", "Prevent flips", true,
-                         "Refuse collapses that turn a triangle over (normal change of 90 degrees or more) or make "
-                         "it degenerate; collapses turning triangles by at most 30 degrees go first."),
-      ParamSpec::real("min_quality", "Min triangle quality", 0, 0, 1,
-                      "Refuse collapses that create triangles of quality (2 inradius / circumradius, 1 = "
-                      "equilateral) below this, unless the triangles they replace were already worse."),
-  };
-  op.run = [](Mesh& mesh, const ParamValues& params, Progress& progress) {
-    DecimateOptions o;
-    o.target_faces = static_cast<std::size_t>(params.get_int("target_faces"));
-    o.target_ratio = params.get_real("target_ratio");
-    o.max_error = params.get_real("max_error");
-    o.preserve_boundary = params.get_bool("preserve_boundary");
-    o.preserve_uv_seams = params.get_bool("preserve_uv_seams");
-    o.prevent_flips = params.get_bool("prevent_flips");
-    o.min_quality = params.get_real("min_quality");
-    o.keep_input_on_failure = false;
-    const DecimateReport r = decimate(mesh, o, progress);
-    OperationReport report;
-    auto count = [](std::size_t n) { return static_cast<std::int64_t>(n); };
-    report.add("faces_before", count(r.faces_before));
-    report.add("faces_after", count(r.faces_after));
-    report.add("vertices_before", count(r.vertices_before));
-    report.add("vertices_after", count(r.vertices_after));
-    report.add("target_faces", count(r.target_faces));
-    report.add("collapses", count(r.collapses));
-    report.add("triangulated_faces", count(r.triangulated_faces));
-    report.add("max_error", r.max_error);
-    report.add("stopped_by", r.stopped_by);
-    return report;
-  };
-  return op;
+  using O = DecimateOptions;
+  using R = DecimateReport;
+  return Binding<O, R>("decimate", "Decimate", Category::remeshing, help, decimate)
+      .fixed(&O::keep_input_on_failure, false)
+      .option(&O::target_faces, "target_faces", "Target faces", at_least(0),
+              "Number of triangles to reach; 0 uses the target ratio instead. On a closed surface an "
+              "odd count stops one above it, since a collapse there removes two triangles.")
+      .option(&O::target_ratio, "target_ratio", "Target ratio", between(0, 1),
+              "Fraction of the triangles to keep, when target faces is 0.")
+      .option(&O::max_error, "max_error", "Max error", between(0, 1),
+              "Never collapse an edge whose error exceeds this fraction of the bounding-box diagonal "
+              "(it may then stop above the target); 0 = no limit.")
+      .option(&O::preserve_boundary, "preserve_boundary", "Preserve boundary",
+              "Boundary vertices stay where they are; boundary edges only collapse along the boundary.")
+      .option(&O::preserve_uv_seams, "preserve_uv_seams", "Preserve UV seams",
+              "Keep per-corner attributes (UVs, corner normals, colours) continuous: vertices on a seam "
+              "only move along it, seam ends and junctions stay.")
+      .option(&O::prevent_flips, "prevent_flips", "Prevent flips",
+              "Refuse collapses that turn a triangle over (normal change of 90 degrees or more) or make "
+              "it degenerate; collapses turning triangles by at most 30 degrees go first.")
+      .option(&O::min_quality, "min_quality", "Min triangle quality", between(0, 1),
+              "Refuse collapses that create triangles of quality (2 inradius / circumradius, 1 = "
+              "equilateral) below this, unless the triangles they replace were already worse.")
+      .result(&R::faces_before, "faces_before")
+      .result(&R::faces_after, "faces_after")
+      .result(&R::vertices_before, "vertices_before")
+      .result(&R::vertices_after, "vertices_after")
+      .result(&R::target_faces, "target_faces")
+      .result(&R::collapses, "collapses")
+      .result(&R::triangulated_faces, "triangulated_faces")
+      .result(&R::max_error, "max_error")
+      .result(&R::stopped_by, "stopped_by");
 }
 
 }  // namespace hedge

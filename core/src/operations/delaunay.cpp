@@ -12,6 +12,7 @@
 #include "hedge/error.h"
 #include "hedge/normals.h"
 #include "hedge/provenance.h"
+#include "binding.h"
 #include "welded_copies.h"
 
 namespace hedge {
@@ -205,11 +206,7 @@ DelaunayReport make_delaunay(Mesh& mesh, const DelaunayOptions& options, Progres
 }
 
 Operation make_delaunay_operation() {
-  Operation op;
-  op.id = "make_delaunay";
-  op.title = "Make Delaunay";
-  op.category = "Cleaning";
-  op.help =
+  const char* help =
       "Flips edges until every interior edge is locally Delaunay (its two opposite angles sum to at most 180 "
       "degrees), which removes needless slivers without moving any vertex: Lawson's flip algorithm, on the "
       "surface. Triangle meshes only (run Triangulate first). Never flipped: boundary edges; feature edges, whose "
@@ -220,34 +217,34 @@ Operation make_delaunay_operation() {
       "duplicate an existing edge. On curved surfaces flipping stops after 50 flips per edge and the report says "
       "so. Vertices, faces and their attributes are kept; corner attributes move with their corners. The report "
       "counts flips and the edges left non-Delaunay, by reason.";
-  op.params = {
-      ParamSpec::real("feature_angle", "Feature angle", 30, 0, 180,
-                      "edges whose faces meet at a dihedral angle above this (degrees) are features and are never "
-                      "flipped"),
+  using O = DelaunayOptions;
+  using R = DelaunayReport;
+  auto after = [](std::size_t DelaunayCensus::*count) {
+    return [count](const O&, const R& r) -> std::optional<Value> { return field_value(r.after.*count); };
   };
-  op.run = [](Mesh& mesh, const ParamValues& values, Progress& progress) {
-    DelaunayOptions options;
-    options.feature_angle = values.get_real("feature_angle");
-    options.keep_input_on_failure = false;
-    DelaunayReport r = make_delaunay(mesh, options, progress);
-    OperationReport report;
-    auto count = [](std::size_t n) { return std::int64_t(n); };
-    report.add("flips", count(r.flips));
-    report.add("interior_edges", count(r.after.interior_edges));
-    report.add("non_delaunay_before", count(r.before.non_delaunay));
-    report.add("non_delaunay_after", count(r.after.non_delaunay));
-    report.add("kept_features", count(r.after.features));
-    report.add("kept_seams", count(r.after.seams));
-    report.add("blocked_by_existing_edges", count(r.after.blocked));
-    report.add("blocked_by_folds", count(r.after.folds));
-    report.add("budget_exhausted", r.budget_exhausted);
-    if (r.budget_exhausted)
-      report.messages.push_back("stopped after " + std::to_string(r.flips) +
-                                " flips (50 per edge): the surface did not settle; " +
-                                std::to_string(r.after.flippable) + " edges could still be flipped");
-    return report;
-  };
-  return op;
+  return Binding<O, R>("make_delaunay", "Make Delaunay", Category::cleaning, help, make_delaunay)
+      .fixed(&O::keep_input_on_failure, false)
+      .option(&O::feature_angle, "feature_angle", "Feature angle", between(0, 180),
+              "edges whose faces meet at a dihedral angle above this (degrees) are features and are never "
+              "flipped")
+      .result(&R::flips, "flips")
+      .result("interior_edges", after(&DelaunayCensus::interior_edges))
+      .result("non_delaunay_before",
+              [](const O&, const R& r) -> std::optional<Value> { return field_value(r.before.non_delaunay); })
+      .result("non_delaunay_after", after(&DelaunayCensus::non_delaunay))
+      .result("kept_features", after(&DelaunayCensus::features))
+      .result("kept_seams", after(&DelaunayCensus::seams))
+      .result("blocked_by_existing_edges", after(&DelaunayCensus::blocked))
+      .result("blocked_by_folds", after(&DelaunayCensus::folds))
+      .result(&R::budget_exhausted, "budget_exhausted")
+      .messages([](const O&, const R& r) {
+        std::vector<std::string> out;
+        if (r.budget_exhausted)
+          out.push_back("stopped after " + std::to_string(r.flips) +
+                        " flips (50 per edge): the surface did not settle; " + std::to_string(r.after.flippable) +
+                        " edges could still be flipped");
+        return out;
+      });
 }
 
 }  // namespace hedge

@@ -16,7 +16,9 @@
 #include <vector>
 
 #include "hedge/error.h"
+#include "hedge/provenance.h"
 #include "hedge/topology.h"
+#include "binding.h"
 
 namespace hedge {
 namespace {
@@ -664,7 +666,7 @@ void HoleFiller::finish_attributes() {
   // build()'s "hedge:flipped" is the exception to the defaults: extract() turns flipped
   // faces back as the host had them, and the patch must turn with its neighbours to stay
   // consistently oriented in the host's eyes.
-  TypedArray<bool>* flipped = mesh_.face_properties().get<bool>("hedge:flipped");
+  TypedArray<bool>* flipped = mesh_.face_properties().get<bool>(provenance::kFlipped);
   std::vector<std::pair<Face, Face>> queue;  // (patch face, face to copy from)
   std::size_t head = 0;
   for (Halfedge b : loop_) queue.emplace_back(mesh_.face(b), mesh_.face(mesh_.opposite(b)));
@@ -795,11 +797,7 @@ FillHolesReport fill_holes(Mesh& input, const FillHolesOptions& options, Progres
 }
 
 Operation fill_holes_operation() {
-  Operation op;
-  op.id = "fill_holes";
-  op.title = "Fill Holes";
-  op.category = "Cleaning";
-  op.help =
+  const char* help =
       "Closes the holes of a surface (Liepa, \"Filling holes in meshes\", SGP 2003). Each boundary loop is "
       "triangulated by dynamic programming, minimising the largest dihedral angle and then the area "
       "(Barequet-Sharir weight), so the patch meets the surface as flatly as possible; loops longer than 300 "
@@ -812,36 +810,26 @@ Operation fill_holes_operation() {
       "quality, normals...), new faces copy those of the nearest face across the hole, and per-corner "
       "attributes such as UVs are carried in from the border. Use it to make a scan watertight before "
       "printing, booleans or volume measures.";
-  op.params = {
-      ParamSpec::integer("max_hole_edges", "Max hole size (edges)", 0, 0, 2147483647,
-                         "Holes with more boundary edges are left open and reported; 0 fills every hole."),
-      ParamSpec::boolean("refine", "Refine patch", true,
-                         "Split and relax the new triangles until they are sized like their surroundings."),
-      ParamSpec::boolean("fair", "Fair patch", true,
-                         "Move the new vertices so the patch is smooth and blends with the surface "
-                         "(bi-Laplacian, Δ²x = 0)."),
-  };
-  op.run = [](Mesh& mesh, const ParamValues& values, Progress& progress) {
-    FillHolesOptions options;
-    options.max_hole_edges = static_cast<std::size_t>(values.get_int("max_hole_edges"));
-    options.refine = values.get_bool("refine");
-    options.fair = values.get_bool("fair");
-    FillHolesReport r = fill_holes(mesh, options, progress);
-    OperationReport report;
-    auto count = [](std::size_t n) { return static_cast<std::int64_t>(n); };
-    report.add("holes_found", count(r.holes_found));
-    report.add("holes_filled", count(r.holes_filled));
-    report.add("holes_skipped", count(r.holes_skipped));
-    report.add("holes_too_large", count(r.holes_too_large));
-    report.add("lone_faces_left_open", count(r.lone_faces));
-    report.add("two_edge_slits_left_open", count(r.slits));
-    report.add("non_manifold_seams_left_open", count(r.split_seams));
-    report.add("triangles_added", count(r.triangles_added));
-    report.add("vertices_added", count(r.vertices_added));
-    report.messages = r.messages;
-    return report;
-  };
-  return op;
+  using O = FillHolesOptions;
+  using R = FillHolesReport;
+  return Binding<O, R>("fill_holes", "Fill Holes", Category::cleaning, help, fill_holes)
+      .option(&O::max_hole_edges, "max_hole_edges", "Max hole size (edges)", at_least(0),
+              "Holes with more boundary edges are left open and reported; 0 fills every hole.")
+      .option(&O::refine, "refine", "Refine patch",
+              "Split and relax the new triangles until they are sized like their surroundings.")
+      .option(&O::fair, "fair", "Fair patch",
+              "Move the new vertices so the patch is smooth and blends with the surface "
+              "(bi-Laplacian, Δ²x = 0).")
+      .result(&R::holes_found, "holes_found")
+      .result(&R::holes_filled, "holes_filled")
+      .result(&R::holes_skipped, "holes_skipped")
+      .result(&R::holes_too_large, "holes_too_large")
+      .result(&R::lone_faces, "lone_faces_left_open")
+      .result(&R::slits, "two_edge_slits_left_open")
+      .result(&R::split_seams, "non_manifold_seams_left_open")
+      .result(&R::triangles_added, "triangles_added")
+      .result(&R::vertices_added, "vertices_added")
+      .messages(&R::messages);
 }
 
 }  // namespace hedge

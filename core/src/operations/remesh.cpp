@@ -13,8 +13,9 @@
 
 #include "hedge/distance.h"
 #include "hedge/error.h"
+#include "hedge/geometry.h"
 #include "hedge/provenance.h"
-#include "hedge/report.h"
+#include "binding.h"
 #include "parallel.h"
 #include "welded_copies.h"
 
@@ -947,11 +948,7 @@ RemeshReport remesh(Mesh& mesh, const RemeshOptions& options, Progress& progress
 }
 
 Operation remesh_operation() {
-  Operation op;
-  op.id = "remesh";
-  op.title = "Isotropic Remesh";
-  op.category = "Remeshing";
-  op.help =
+  const char* help =
       "Rebuilds the surface with nearly equilateral triangles of one edge length: repeatedly splits long edges, "
       "collapses short ones, flips edges toward six neighbours per vertex, smooths tangentially and projects back "
       "onto the original surface (Botsch & Kobbelt 2004, \"A remeshing approach to multiresolution modeling\"). "
@@ -960,44 +957,35 @@ Operation remesh_operation() {
       "texture coordinates, corner normals or face attributes change (seams) are kept as well. Vertex and corner "
       "attributes (colours, UVs, normals) are interpolated on splits and resampled from the original surface where "
       "vertices move; face attributes are copied to the faces that continue them.";
-  op.params = {
-      ParamSpec::real("target_edge_length", "Target edge length", 0, 0, 1e30,
-                      "Edge length to reach, in model units; 0 uses the mean edge length of the input."),
-      ParamSpec::integer("iterations", "Iterations", 5, 1, 100,
-                         "Rounds of split, collapse, flip, smooth and project; 3 to 10 is typical."),
-      ParamSpec::real("feature_angle", "Feature angle", 45, 0, 180,
-                      "Edges whose faces meet at a dihedral angle above this many degrees are sharp features: "
-                      "they are kept (only split), and their vertices slide only along them. 180 turns this off."),
-      ParamSpec::boolean("preserve_boundary", "Preserve boundary", true,
-                         "Keep boundary edges (only split) and boundary vertices fixed; otherwise boundary edges may "
-                         "also collapse and boundary vertices slide along the boundary."),
-      ParamSpec::boolean("adaptive", "Adaptive", false,
-                         "Let the edge length follow curvature: shorter where the surface bends (down to a quarter of "
-                         "the target), longer where it is flat (up to twice the target)."),
-  };
-  op.run = [](Mesh& mesh, const ParamValues& params, Progress& progress) {
-    RemeshOptions options;
-    options.target_edge_length = params.get_real("target_edge_length");
-    options.iterations = static_cast<int>(params.get_int("iterations"));
-    options.feature_angle = params.get_real("feature_angle");
-    options.preserve_boundary = params.get_bool("preserve_boundary");
-    options.adaptive = params.get_bool("adaptive");
-    RemeshReport r = remesh(mesh, options, progress);
-    OperationReport report;
-    auto count = [](std::size_t n) { return static_cast<std::int64_t>(n); };
-    report.add("target_edge_length", r.target_edge_length);
-    report.add("input_faces", count(r.input_faces));
-    report.add("faces", count(r.output_faces));
-    report.add("vertices", count(r.output_vertices));
-    report.add("splits", count(r.splits));
-    report.add("collapses", count(r.collapses));
-    report.add("flips", count(r.flips));
-    report.add("feature_edges", count(r.feature_edges));
-    report.add("fixed_vertices", count(r.fixed_vertices));
-    if (r.triangulated_faces) report.add("triangulated_faces", count(r.triangulated_faces));
-    return report;
-  };
-  return op;
+  using O = RemeshOptions;
+  using R = RemeshReport;
+  return Binding<O, R>("remesh", "Isotropic Remesh", Category::remeshing, help, remesh)
+      .option(&O::target_edge_length, "target_edge_length", "Target edge length", at_least(0),
+              "Edge length to reach, in model units; 0 uses the mean edge length of the input.")
+      .option(&O::iterations, "iterations", "Iterations", between(1, 100),
+              "Rounds of split, collapse, flip, smooth and project; 3 to 10 is typical.")
+      .option(&O::feature_angle, "feature_angle", "Feature angle", between(0, 180),
+              "Edges whose faces meet at a dihedral angle above this many degrees are sharp features: "
+              "they are kept (only split), and their vertices slide only along them. 180 turns this off.")
+      .option(&O::preserve_boundary, "preserve_boundary", "Preserve boundary",
+              "Keep boundary edges (only split) and boundary vertices fixed; otherwise boundary edges may "
+              "also collapse and boundary vertices slide along the boundary.")
+      .option(&O::adaptive, "adaptive", "Adaptive",
+              "Let the edge length follow curvature: shorter where the surface bends (down to a quarter of "
+              "the target), longer where it is flat (up to twice the target).")
+      .result(&R::target_edge_length, "target_edge_length")
+      .result(&R::input_faces, "input_faces")
+      .result(&R::output_faces, "faces")
+      .result(&R::output_vertices, "vertices")
+      .result(&R::splits, "splits")
+      .result(&R::collapses, "collapses")
+      .result(&R::flips, "flips")
+      .result(&R::feature_edges, "feature_edges")
+      .result(&R::fixed_vertices, "fixed_vertices")
+      .result("triangulated_faces", [](const O&, const R& r) -> std::optional<Value> {
+        if (!r.triangulated_faces) return std::nullopt;
+        return field_value(r.triangulated_faces);
+      });
 }
 
 }  // namespace hedge

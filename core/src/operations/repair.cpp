@@ -14,7 +14,10 @@
 
 #include "hedge/build.h"
 #include "hedge/error.h"
+#include "hedge/provenance.h"
 #include "hedge/soup.h"
+#include "binding.h"
+#include "text.h"
 
 namespace hedge {
 namespace {
@@ -28,9 +31,7 @@ void keep_elements(Channel& channel, const std::vector<std::uint32_t>& kept) {
   channel.data = std::move(data);
 }
 
-std::string plural(std::size_t n, const char* one, const char* many) {
-  return std::to_string(n) + " " + (n == 1 ? one : many);
-}
+using detail::plural;
 
 std::string number(double x) {
   char buffer[32];
@@ -40,9 +41,9 @@ std::string number(double x) {
 
 // ---- provenance ---------------------------------------------------------------------------
 
-const char* const kVertexSource = "hedge:source";
-const char* const kFaceSource = "hedge:source";
-const char* const kFaceFlipped = "hedge:flipped";
+using provenance::kFaceSource;
+using provenance::kFlipped;
+using provenance::kVertexSource;
 
 //! The soup vertex a mesh vertex came from; vertices build() did not make get ids of their own.
 class SourceOf {
@@ -64,7 +65,7 @@ class SourceOf {
 void drop_provenance(Mesh& mesh) {
   mesh.vertex_properties().remove(kVertexSource);
   mesh.face_properties().remove(kFaceSource);
-  mesh.face_properties().remove(kFaceFlipped);
+  mesh.face_properties().remove(kFlipped);
 }
 
 // ---- duplicate faces ------------------------------------------------------------------------
@@ -150,15 +151,22 @@ void for_each_multi_edge(const Mesh& mesh, const std::vector<std::uint32_t>& id,
   }
 }
 
-bool has_duplicate_faces(const Mesh& mesh) {
-  SourceOf source(mesh);
+//! Per face of the mesh, in order: 1 when an earlier face has the same vertex set, vertices
+//! named by `id` (build()'s source, or the mesh vertex itself).
+template <class VertexId>
+std::vector<char> later_duplicate_faces(const Mesh& mesh, VertexId id) {
   std::vector<std::uint32_t> sizes;
   std::vector<std::uint64_t> ids;
   for (Face f : mesh.faces()) {
     sizes.push_back(static_cast<std::uint32_t>(mesh.valence(f)));
-    for (Vertex v : mesh.vertices(f)) ids.push_back(source(v));
+    for (Vertex v : mesh.vertices(f)) ids.push_back(id(v));
   }
-  return count_true(later_duplicates(sizes, ids)) > 0;
+  return later_duplicates(sizes, ids);
+}
+
+bool has_duplicate_faces(const Mesh& mesh) {
+  const SourceOf source(mesh);
+  return count_true(later_duplicate_faces(mesh, [&](Vertex v) { return source(v); })) > 0;
 }
 
 // ---- soup editing ---------------------------------------------------------------------------
@@ -410,15 +418,9 @@ std::size_t remove_pinches(Mesh& mesh) {
 //! edge, say), which extract() would hand on as a duplicate face: the later ones go.
 //! Returns the faces removed.
 std::size_t remove_duplicate_faces(Mesh& mesh) {
-  std::vector<std::uint32_t> sizes;
-  std::vector<std::uint64_t> ids;
   std::vector<Face> faces;
-  for (Face f : mesh.faces()) {
-    faces.push_back(f);
-    sizes.push_back(static_cast<std::uint32_t>(mesh.valence(f)));
-    for (Vertex v : mesh.vertices(f)) ids.push_back(v.idx());
-  }
-  const std::vector<char> drop = later_duplicates(sizes, ids);
+  for (Face f : mesh.faces()) faces.push_back(f);
+  const std::vector<char> drop = later_duplicate_faces(mesh, [](Vertex v) { return v.idx(); });
   for (std::size_t i = 0; i < faces.size(); ++i)
     if (drop[i]) mesh.delete_face(faces[i]);
   return count_true(drop);
@@ -472,7 +474,7 @@ BuildRepairs build_repairs(const Mesh& mesh) {
     ++(faces >= 3 ? r.non_manifold_edges : r.edges_cut);
   });
 
-  if (const auto* flipped = mesh.face_properties().get<bool>(kFaceFlipped))
+  if (const auto* flipped = mesh.face_properties().get<bool>(kFlipped))
     for (Face f : mesh.faces()) r.faces_flipped += flipped->vector()[f.idx()] ? 1 : 0;
 
   if (const auto* face_source = mesh.face_properties().get<std::uint32_t>(kFaceSource)) {
@@ -606,11 +608,7 @@ RepairReport repair(Mesh& mesh, const RepairOptions& options, Progress& progress
 }
 
 Operation repair_operation() {
-  Operation op;
-  op.id = "repair";
-  op.title = "Repair";
-  op.category = "Cleaning";
-  op.help =
+  const char* help =
       "Makes the mesh clean for tools that need a manifold, consistently oriented surface, and keeps the "
       "result: non-manifold edges and vertices are split into manifold copies and faces are flipped to a "
       "consistent orientation (the repairs the core always makes internally, which other operations give "
@@ -620,34 +618,25 @@ Operation repair_operation() {
       "any repair. Vertex copies keep their vertex's attributes; faces and corners keep theirs. Orientation "
       "follows the majority of each connected part. Run it before operations or exports that refuse "
       "non-manifold input (3D printing, booleans).";
-  op.params = {
-      ParamSpec::real("weld_distance", "Weld distance", 0, 0, 1e30,
-                      "Vertices at most this far apart (in the mesh's units) are merged into one; 0 leaves them."),
-      ParamSpec::boolean("remove_isolated_vertices", "Remove isolated vertices", true,
-                         "Remove vertices that no face uses."),
-  };
-  op.run = [](Mesh& mesh, const ParamValues& values, Progress& progress) {
-    RepairOptions options;
-    options.weld_distance = values.get_real("weld_distance");
-    options.remove_isolated_vertices = values.get_bool("remove_isolated_vertices");
-    RepairReport r = repair(mesh, options, progress);
-    OperationReport report;
-    auto count = [](std::size_t n) { return static_cast<std::int64_t>(n); };
-    report.add("non_manifold_edges_split", count(r.non_manifold_edges_split));
-    report.add("non_manifold_vertices_split", count(r.non_manifold_vertices_split));
-    report.add("vertex_copies_added", count(r.vertex_copies_added));
-    report.add("faces_flipped", count(r.faces_flipped));
-    report.add("repeated_vertex_faces_split", count(r.repeated_vertex_faces_split));
-    report.add("edges_cut", count(r.edges_cut));
-    report.add("degenerate_faces_removed", count(r.degenerate_faces_removed));
-    report.add("duplicate_faces_removed", count(r.duplicate_faces_removed));
-    report.add("vertices_welded", count(r.vertices_welded));
-    report.add("pinched_faces_removed", count(r.pinched_faces_removed));
-    report.add("isolated_vertices_removed", count(r.isolated_vertices_removed));
-    report.messages = r.messages;
-    return report;
-  };
-  return op;
+  using O = RepairOptions;
+  using R = RepairReport;
+  return Binding<O, R>("repair", "Repair", Category::cleaning, help, repair)
+      .option(&O::weld_distance, "weld_distance", "Weld distance", at_least(0),
+              "Vertices at most this far apart (in the mesh's units) are merged into one; 0 leaves them.")
+      .option(&O::remove_isolated_vertices, "remove_isolated_vertices", "Remove isolated vertices",
+              "Remove vertices that no face uses.")
+      .result(&R::non_manifold_edges_split, "non_manifold_edges_split")
+      .result(&R::non_manifold_vertices_split, "non_manifold_vertices_split")
+      .result(&R::vertex_copies_added, "vertex_copies_added")
+      .result(&R::faces_flipped, "faces_flipped")
+      .result(&R::repeated_vertex_faces_split, "repeated_vertex_faces_split")
+      .result(&R::edges_cut, "edges_cut")
+      .result(&R::degenerate_faces_removed, "degenerate_faces_removed")
+      .result(&R::duplicate_faces_removed, "duplicate_faces_removed")
+      .result(&R::vertices_welded, "vertices_welded")
+      .result(&R::pinched_faces_removed, "pinched_faces_removed")
+      .result(&R::isolated_vertices_removed, "isolated_vertices_removed")
+      .messages(&R::messages);
 }
 
 }  // namespace hedge

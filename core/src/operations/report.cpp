@@ -7,22 +7,9 @@
 #include <numbers>
 #include <vector>
 
+#include "binding.h"
+
 namespace hedge {
-
-double triangle_quality(const Vec3d& a, const Vec3d& b, const Vec3d& c) {
-  // 2 r_in / r_out = 8 (s - la)(s - lb)(s - lc) / (la lb lc), with s the half perimeter (Heron).
-  double la = distance(b, c), lb = distance(a, c), lc = distance(a, b);
-  double s = 0.5 * (la + lb + lc);
-  double denom = la * lb * lc;
-  if (denom <= 0) return 0;
-  double q = 8.0 * (s - la) * (s - lb) * (s - lc) / denom;
-  return std::clamp(q, 0.0, 1.0);
-}
-
-double triangle_min_angle(const Vec3d& a, const Vec3d& b, const Vec3d& c) {
-  double m = std::min({angle_at(a, b, c), angle_at(b, c, a), angle_at(c, a, b)});
-  return m * 180.0 / std::numbers::pi;
-}
 
 MeshStatistics mesh_statistics(const Mesh& mesh) {
   MeshStatistics s;
@@ -128,57 +115,56 @@ MeshStatistics mesh_statistics(const Mesh& mesh) {
   return s;
 }
 
-void add_statistics(const MeshStatistics& s, OperationReport& r) {
-  const auto& t = s.topology;
-  auto count = [](std::size_t n) { return static_cast<std::int64_t>(n); };
-  r.add("vertices", count(t.vertices));
-  r.add("edges", count(t.edges));
-  r.add("faces", count(t.faces));
-  r.add("halfedges", count(t.halfedges));
-  r.add("triangles", count(s.triangles));
-  r.add("quads", count(s.quads));
-  r.add("polygons", count(s.polygons));
-  r.add("isolated_vertices", count(t.isolated_vertices));
-  r.add("boundary_loops", count(t.boundary_loops));
-  r.add("boundary_edges", count(t.boundary_edges));
-  r.add("components", count(t.components));
-  r.add("euler_characteristic", t.euler_characteristic);
-  r.add("genus", t.genus);
-  r.add("degenerate_faces", count(s.degenerate_faces));
-  r.add("multi_edges", count(s.multi_edges));
-  r.add("edge_length_min", s.edge_length_min);
-  r.add("edge_length_mean", s.edge_length_mean);
-  r.add("edge_length_max", s.edge_length_max);
-  r.add("edge_length_stddev", s.edge_length_stddev);
-  r.add("min_angle_degrees", s.min_angle_degrees);
-  r.add("mean_min_angle_degrees", s.mean_min_angle_degrees);
-  r.add("quality_min", s.quality_min);
-  r.add("quality_mean", s.quality_mean);
-  r.add("area", s.area);
-  r.add("volume", s.volume);
-  r.add("bbox_diagonal", s.bbox_diagonal);
-  r.add("valence_min", count(s.valence_min));
-  r.add("valence_max", count(s.valence_max));
-  r.add("valence_irregular_fraction", s.valence_irregular_fraction);
-}
+namespace {
+//! The report takes no options.
+struct ReportOptions {};
+}  // namespace
 
 Operation report_operation() {
-  Operation op;
-  op.id = "report";
-  op.title = "Mesh Report";
-  op.category = "Measure";
-  op.help =
+  const char* help =
       "Measures the mesh without changing it: element counts, boundary loops, connected components, Euler "
       "characteristic and genus, what building had to repair (non-manifold edges and vertices, flipped and "
       "skipped faces), degenerate faces, edge-length and triangle-quality statistics.";
-  op.changes_mesh = false;
-  op.run = [](Mesh& mesh, const ParamValues&, Progress& progress) {
+  using O = ReportOptions;
+  using R = MeshStatistics;
+  auto run = [](Mesh& mesh, const O&, Progress& progress) {
     progress.update(0.5, "measuring");
-    OperationReport report;
-    add_statistics(mesh_statistics(mesh), report);
-    return report;
+    return mesh_statistics(mesh);
   };
-  return op;
+  auto topology = [](auto TopologyStats::*field) {
+    return [field](const O&, const R& r) -> std::optional<Value> { return field_value(r.topology.*field); };
+  };
+  return Binding<O, R>("report", "Mesh Report", Category::measure, help, run)
+      .measures_only()
+      .result("vertices", topology(&TopologyStats::vertices))
+      .result("edges", topology(&TopologyStats::edges))
+      .result("faces", topology(&TopologyStats::faces))
+      .result("halfedges", topology(&TopologyStats::halfedges))
+      .result(&R::triangles, "triangles")
+      .result(&R::quads, "quads")
+      .result(&R::polygons, "polygons")
+      .result("isolated_vertices", topology(&TopologyStats::isolated_vertices))
+      .result("boundary_loops", topology(&TopologyStats::boundary_loops))
+      .result("boundary_edges", topology(&TopologyStats::boundary_edges))
+      .result("components", topology(&TopologyStats::components))
+      .result("euler_characteristic", topology(&TopologyStats::euler_characteristic))
+      .result("genus", topology(&TopologyStats::genus))
+      .result(&R::degenerate_faces, "degenerate_faces")
+      .result(&R::multi_edges, "multi_edges")
+      .result(&R::edge_length_min, "edge_length_min")
+      .result(&R::edge_length_mean, "edge_length_mean")
+      .result(&R::edge_length_max, "edge_length_max")
+      .result(&R::edge_length_stddev, "edge_length_stddev")
+      .result(&R::min_angle_degrees, "min_angle_degrees")
+      .result(&R::mean_min_angle_degrees, "mean_min_angle_degrees")
+      .result(&R::quality_min, "quality_min")
+      .result(&R::quality_mean, "quality_mean")
+      .result(&R::area, "area")
+      .result(&R::volume, "volume")
+      .result(&R::bbox_diagonal, "bbox_diagonal")
+      .result(&R::valence_min, "valence_min")
+      .result(&R::valence_max, "valence_max")
+      .result(&R::valence_irregular_fraction, "valence_irregular_fraction");
 }
 
 }  // namespace hedge

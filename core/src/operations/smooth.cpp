@@ -12,6 +12,7 @@
 
 #include "hedge/error.h"
 #include "hedge/normals.h"
+#include "binding.h"
 #include "parallel.h"
 
 namespace hedge {
@@ -226,11 +227,7 @@ SmoothReport smooth(Mesh& mesh, const SmoothOptions& options, Progress& progress
 }
 
 Operation smooth_operation() {
-  Operation op;
-  op.id = "smooth";
-  op.title = "Smooth";
-  op.category = "Smoothing";
-  op.help =
+  const char* help =
       "Removes noise by moving every vertex toward a weighted mean of its neighbours, all vertices at once, "
       "repeated. Methods: uniform (the umbrella operator: simple and fast, but the shape shrinks and triangles "
       "slide along the surface), cotangent (Desbrun et al. 1999: cotangent weights, clamped and normalized, so "
@@ -240,39 +237,38 @@ Operation smooth_operation() {
       "preserve_boundary, boundary vertices stay fixed; otherwise they are smoothed along their boundary curve. "
       "Only positions change: the connectivity and every attribute are kept, except vertex and face normals, which "
       "are recomputed from the new shape.";
-  op.params = {
-      ParamSpec::choice("method", "Method", {"uniform", "cotangent", "taubin"}, 0,
-                        "uniform is fastest but shrinks; cotangent follows the surface; taubin keeps the volume"),
-      ParamSpec::integer("iterations", "Iterations", 10, 1, 1000, "number of smoothing steps"),
-      ParamSpec::real("strength", "Strength", 0.5, 0, 1,
-                      "λ: how far each step moves a vertex toward the mean (0 to 1)"),
-      ParamSpec::boolean("preserve_boundary", "Preserve boundary", true,
-                         "keep boundary vertices fixed (otherwise smooth them along the boundary)"),
+  using O = SmoothOptions;
+  using R = SmoothReport;
+  auto run = [](Mesh& mesh, const O& options, Progress& progress) {
+    if (options.strength > 0) return smooth(mesh, options, progress);
+    R nothing;
+    nothing.message = "strength 0: nothing to do";
+    return nothing;
   };
-  op.run = [](Mesh& mesh, const ParamValues& values, Progress& progress) {
-    SmoothOptions options;
-    options.method = smoothing_method_from_name(values.get_choice("method"));
-    options.iterations = int(values.get_int("iterations"));
-    options.strength = values.get_real("strength");
-    options.preserve_boundary = values.get_bool("preserve_boundary");
-    OperationReport report;
-    if (options.strength <= 0) {
-      report.add("moved_vertices", std::int64_t(0));
-      report.messages.push_back("strength 0: nothing to do");
-      return report;
-    }
-    SmoothReport r = smooth(mesh, options, progress);
-    report.add("method", std::string(smoothing_method_name(options.method)));
-    report.add("iterations", std::int64_t(r.iterations));
-    report.add("moved_vertices", std::int64_t(r.moved_vertices));
-    report.add("lambda", r.lambda);
-    if (options.method == SmoothingMethod::taubin) report.add("mu", r.mu);
-    report.add("mean_displacement", r.mean_displacement);
-    report.add("max_displacement", r.max_displacement);
-    if (!r.message.empty()) report.messages.push_back(r.message);
-    return report;
-  };
-  return op;
+  return Binding<O, R>("smooth", "Smooth", Category::smoothing, help, run)
+      .choice(&O::method, "method", "Method",
+              {SmoothingMethod::uniform, SmoothingMethod::cotangent, SmoothingMethod::taubin}, smoothing_method_name,
+              "uniform is fastest but shrinks; cotangent follows the surface; taubin keeps the volume")
+      .option(&O::iterations, "iterations", "Iterations", between(1, 1000), "number of smoothing steps")
+      .option(&O::strength, "strength", "Strength", between(0, 1),
+              "λ: how far each step moves a vertex toward the mean (0 to 1)")
+      .option(&O::preserve_boundary, "preserve_boundary", "Preserve boundary",
+              "keep boundary vertices fixed (otherwise smooth them along the boundary)")
+      .result("method", [](const O& o, const R&) -> std::optional<Value> {
+        return std::string(smoothing_method_name(o.method));
+      })
+      .result(&R::iterations, "iterations")
+      .result(&R::moved_vertices, "moved_vertices")
+      .result(&R::lambda, "lambda")
+      .result("mu", [](const O& o, const R& r) -> std::optional<Value> {
+        if (o.method != SmoothingMethod::taubin) return std::nullopt;
+        return r.mu;
+      })
+      .result(&R::mean_displacement, "mean_displacement")
+      .result(&R::max_displacement, "max_displacement")
+      .messages([](const O&, const R& r) {
+        return r.message.empty() ? std::vector<std::string>{} : std::vector<std::string>{r.message};
+      });
 }
 
 }  // namespace hedge

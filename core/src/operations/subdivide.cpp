@@ -18,7 +18,9 @@
 #include "hedge/error.h"
 #include "hedge/limits.h"
 #include "hedge/normals.h"
+#include "hedge/provenance.h"
 #include "hedge/topology.h"
+#include "binding.h"
 #include "parallel.h"
 #include "welded_copies.h"
 
@@ -1010,8 +1012,8 @@ Mesh sqrt3_step(const Mesh& m, bool trisect, std::vector<bool>& crease, unsigned
 //! (the welded point takes the first copy's position). New sources are numbered after the
 //! largest one in use, in the order of the welded edges they sit on.
 void weld_split_edge_points(const Mesh& before, Mesh& after) {
-  const auto* old_source = before.vertex_properties().get<std::uint32_t>("hedge:source");
-  auto* source = after.vertex_properties().get<std::uint32_t>("hedge:source");
+  const auto* old_source = before.vertex_properties().get<std::uint32_t>(provenance::kVertexSource);
+  auto* source = after.vertex_properties().get<std::uint32_t>(provenance::kVertexSource);
   if (!old_source || !source) return;
   const Index V = Index(before.vertices_size());
   std::uint64_t next = 0;
@@ -1237,6 +1239,7 @@ SubdivideReport subdivide(Mesh& mesh, const SubdivideOptions& options, Progress&
     throw Error("subdivide: crease_angle must be from 0 to 180 degrees");
   const bool triangles_only = options.scheme == SubdivisionScheme::loop || options.scheme == SubdivisionScheme::sqrt3;
   const FaceCensus faces = face_census(mesh);
+  const std::size_t faces_before = mesh.n_faces();
   if (triangles_only) {
     if (std::size_t polygons = faces.faces - faces.triangles)
       throw Error(std::string("subdivide: the ") + name + " scheme works on triangle meshes, and " +
@@ -1290,6 +1293,7 @@ SubdivideReport subdivide(Mesh& mesh, const SubdivideOptions& options, Progress&
   normalize_corner_normals(mesh);
 
   SubdivideReport report;
+  report.faces_before = faces_before;
   report.vertices = mesh.n_vertices();
   report.edges = mesh.n_edges();
   report.faces = mesh.n_faces();
@@ -1299,11 +1303,7 @@ SubdivideReport subdivide(Mesh& mesh, const SubdivideOptions& options, Progress&
 }
 
 Operation subdivide_operation() {
-  Operation op;
-  op.id = "subdivide";
-  op.title = "Subdivide";
-  op.category = "Remeshing";
-  op.help =
+  const char* help =
       "Refines the surface: every step replaces each face by smaller ones and moves the vertices toward a smooth "
       "limit surface. Schemes: loop (Loop 1987; triangles 1 to 4, smooth, for triangle meshes), catmull_clark "
       "(Catmull & Clark 1978; every n-gon becomes n quads, for any polygon mesh), sqrt3 (Kobbelt 2000; a vertex "
@@ -1320,34 +1320,32 @@ Operation subdivide_operation() {
       "inside each old face so seams stay seams, face attributes (materials) are copied to the child faces; normals "
       "are recomputed for the new shape. "
       "Results above 200 million faces are refused before starting.";
-  op.params = {
-      ParamSpec::choice("scheme", "Scheme", {"loop", "catmull_clark", "sqrt3", "midpoint"}, 0,
-                        "loop and sqrt3 for triangle meshes, catmull_clark for any polygons (makes quads), "
-                        "midpoint to refine without smoothing"),
-      ParamSpec::integer("iterations", "Iterations", 1, 1, 6,
-                         "refinement steps; each multiplies the face count by 4 (sqrt3: 3)"),
-      ParamSpec::real("crease_angle", "Crease angle", 180, 0, 180,
-                      "degrees: edges where the two faces' normals differ by more than this stay sharp (creases "
-                      "and corners, e.g. a cube's edges at 60); 180 smooths everything"),
-  };
-  op.run = [](Mesh& mesh, const ParamValues& values, Progress& progress) {
-    SubdivideOptions options;
-    options.scheme = subdivision_scheme_from_name(values.get_choice("scheme"));
-    options.iterations = int(values.get_int("iterations"));
-    options.crease_angle = values.get_real("crease_angle");
-    const std::size_t faces_before = mesh.n_faces();
-    SubdivideReport r = subdivide(mesh, options, progress);
-    OperationReport report;
-    report.add("scheme", std::string(subdivision_scheme_name(options.scheme)));
-    report.add("iterations", std::int64_t(r.iterations));
-    if (options.crease_angle < 180) report.add("crease_edges", std::int64_t(r.crease_edges));
-    report.add("faces_before", std::int64_t(faces_before));
-    report.add("vertices", std::int64_t(r.vertices));
-    report.add("edges", std::int64_t(r.edges));
-    report.add("faces", std::int64_t(r.faces));
-    return report;
-  };
-  return op;
+  using O = SubdivideOptions;
+  using R = SubdivideReport;
+  return Binding<O, R>("subdivide", "Subdivide", Category::remeshing, help, subdivide)
+      .choice(&O::scheme, "scheme", "Scheme",
+              {SubdivisionScheme::loop, SubdivisionScheme::catmull_clark, SubdivisionScheme::sqrt3,
+               SubdivisionScheme::midpoint},
+              subdivision_scheme_name,
+              "loop and sqrt3 for triangle meshes, catmull_clark for any polygons (makes quads), "
+              "midpoint to refine without smoothing")
+      .option(&O::iterations, "iterations", "Iterations", between(1, 6),
+              "refinement steps; each multiplies the face count by 4 (sqrt3: 3)")
+      .option(&O::crease_angle, "crease_angle", "Crease angle", between(0, 180),
+              "degrees: edges where the two faces' normals differ by more than this stay sharp (creases "
+              "and corners, e.g. a cube's edges at 60); 180 smooths everything")
+      .result("scheme", [](const O& o, const R&) -> std::optional<Value> {
+        return std::string(subdivision_scheme_name(o.scheme));
+      })
+      .result(&R::iterations, "iterations")
+      .result("crease_edges", [](const O& o, const R& r) -> std::optional<Value> {
+        if (o.crease_angle >= 180) return std::nullopt;
+        return field_value(r.crease_edges);
+      })
+      .result(&R::faces_before, "faces_before")
+      .result(&R::vertices, "vertices")
+      .result(&R::edges, "edges")
+      .result(&R::faces, "faces");
 }
 
 }  // namespace hedge

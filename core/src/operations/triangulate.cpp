@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "hedge/error.h"
+#include "binding.h"
 
 namespace hedge {
 namespace {
@@ -466,11 +467,7 @@ TriangulateReport triangulate(Mesh& mesh, const TriangulateOptions& options, Pro
 }
 
 Operation triangulate_operation() {
-  Operation op;
-  op.id = "triangulate";
-  op.title = "Triangulate";
-  op.category = "Cleaning";
-  op.help =
+  const char* help =
       "Splits every polygon into triangles, convex or not: each triangle lies inside the polygon and faces the "
       "same way, seen in the polygon's best-fit plane (Newell's normal). Methods: min_area chooses, by dynamic "
       "programming over the diagonals, the triangulation of least total area (for non-planar polygons the "
@@ -481,34 +478,33 @@ Operation triangulate_operation() {
       "otherwise, a vertex is added at its centroid. Attributes: new corners copy the polygon's corner value at "
       "the same vertex (UVs stay per face), new faces copy the polygon's face attributes (materials), vertices "
       "are untouched.";
-  op.params = {
-      ParamSpec::choice("method", "Method", {"min_area", "ear_clipping"}, 0,
-                        "min_area for the best triangles (dynamic programming), ear_clipping for speed"),
-  };
-  op.run = [](Mesh& mesh, const ParamValues& values, Progress& progress) {
-    TriangulateOptions options;
-    options.method = triangulation_method_from_name(values.get_choice("method"));
-    options.keep_input_on_failure = false;
-    TriangulateReport r = triangulate(mesh, options, progress);
-    OperationReport report;
-    auto count = [](std::size_t n) { return std::int64_t(n); };
-    report.add("method", std::string(triangulation_method_name(options.method)));
-    report.add("polygons", count(r.polygons));
-    report.add("triangles", count(r.triangles));
-    report.add("ear_clipped", count(r.ear_clipped));
-    report.add("relaxed", count(r.relaxed));
-    report.add("centroid_vertices", count(r.centroid_vertices));
-    if (r.relaxed)
-      report.messages.push_back(std::to_string(r.relaxed) +
-                                " polygons have no triangulation that stays flat in their plane (self-crossing "
-                                "or blocked by existing edges); they were split as well as possible");
-    if (r.centroid_vertices)
-      report.messages.push_back(std::to_string(r.centroid_vertices) +
-                                " polygons could not be split without doubling an edge; a vertex was added at "
-                                "their centroid");
-    return report;
-  };
-  return op;
+  using O = TriangulateOptions;
+  using R = TriangulateReport;
+  return Binding<O, R>("triangulate", "Triangulate", Category::cleaning, help, triangulate)
+      .fixed(&O::keep_input_on_failure, false)
+      .choice(&O::method, "method", "Method", {TriangulationMethod::min_area, TriangulationMethod::ear_clipping},
+              triangulation_method_name,
+              "min_area for the best triangles (dynamic programming), ear_clipping for speed")
+      .result("method", [](const O& o, const R&) -> std::optional<Value> {
+        return std::string(triangulation_method_name(o.method));
+      })
+      .result(&R::polygons, "polygons")
+      .result(&R::triangles, "triangles")
+      .result(&R::ear_clipped, "ear_clipped")
+      .result(&R::relaxed, "relaxed")
+      .result(&R::centroid_vertices, "centroid_vertices")
+      .messages([](const O&, const R& r) {
+        std::vector<std::string> out;
+        if (r.relaxed)
+          out.push_back(std::to_string(r.relaxed) +
+                        " polygons have no triangulation that stays flat in their plane (self-crossing "
+                        "or blocked by existing edges); they were split as well as possible");
+        if (r.centroid_vertices)
+          out.push_back(std::to_string(r.centroid_vertices) +
+                        " polygons could not be split without doubling an edge; a vertex was added at "
+                        "their centroid");
+        return out;
+      });
 }
 
 }  // namespace hedge
