@@ -79,6 +79,10 @@ class Target:
                 bm.clear()
                 bm.from_mesh(self.scratch)
                 bmesh.update_edit_mesh(self.obj.data, loop_triangles=True, destructive=True)
+                # clear() unlinks the edit mesh from its Python wrapper, which a script may
+                # hold (from_edit_mesh hands out one wrapper): left so, it would outlive the
+                # edit mesh and crash Blender when collected. Invalidated, it raises instead.
+                bm.free()
             else:
                 messages = exchange.write_mesh(self.obj.data, self.data, self.result, obj=self.obj)
                 self.obj.data.update()

@@ -1,6 +1,7 @@
 # Every operator on Blender's own primitives (cube, UV sphere, Suzanne) and on real meshes,
 # with the results checked: face counts, holes, edge lengths, UV layers and their continuity,
 # attributes kept; Edit Mode; undo; batch API errors.
+import gc
 import os
 import sys
 
@@ -278,11 +279,18 @@ class PrimitivesTest(unittest.TestCase):
     def test_edit_mode(self):
         obj = add_primitive("monkey")
         bpy.ops.object.mode_set(mode='EDIT')
+        held = bmesh.from_edit_mesh(obj.data)  # a script's wrapper, held across the run
         bpy.ops.mesh.hedge_triangulate()
         bpy.ops.mesh.hedge_decimate(target_faces=300)
         bm = bmesh.from_edit_mesh(obj.data)
         self.assertEqual(len(bm.faces), 300)
+        # The edit mesh was reloaded under it: the old wrapper raises (once it outlived the
+        # edit mesh unknowing and crashed Blender when collected).
+        with self.assertRaises(ReferenceError):
+            len(held.verts)
         bpy.ops.object.mode_set(mode='OBJECT')
+        del held, bm
+        gc.collect()
         self.assertEqual(len(obj.data.polygons), 300)
 
     def test_undo_restores(self):
