@@ -42,42 +42,63 @@ class Target:
         self.result = None
         self.report = None
 
-    def read(self):
+    def read(self, op=None):
+        """Reads the mesh into a soup for `op` (its shape keys too when `op` changes the mesh)."""
         me = self.obj.data
+        keys = me.shape_keys is not None and (op is None or op["changes_mesh"])
         if self.edit:
             # The edit mesh is the truth in Edit Mode: work on a copy, load it back after.
+            # Loading it into the object's mesh first also writes its shape layers into the
+            # key blocks, which are read from there.
             self.obj.update_from_editmode()  # the weights are read from the object's mesh
-            self.scratch = bpy.data.meshes.new("hedge scratch")
-            bmesh.from_edit_mesh(me).to_mesh(self.scratch)
+            if keys:
+                # A copy keeps the key blocks (with the ids that tie them to the edit mesh's
+                # shape layers), for the result to be loaded back with them.
+                self.scratch = me.copy()
+                self.scratch.name = "hedge scratch"
+            else:
+                self.scratch = bpy.data.meshes.new("hedge scratch")
+                bmesh.from_edit_mesh(me).to_mesh(self.scratch)
             me = self.scratch
         self.data = exchange.read_mesh(me)
         exchange.read_vertex_groups(self.obj, self.obj.data, self.data)
+        if keys:
+            exchange.read_shape_keys(me, self.data)
         return self.data.soup
 
     def check_writable(self, op):
         """Refuses, before anything is written, what the exchange cannot keep consistent."""
-        if self.result is None or exchange.same_topology(self.data.soup, self.result):
+        if self.result is None:
             return
-        if self.obj.data.shape_keys is not None:
-            raise Error(f"{self.obj.name} has shape keys, which cannot follow {op['title']} (it changes the "
-                        f"vertices); apply or remove them first")
+        # Keys added, removed or renamed since the read (an interactive run leaves the UI
+        # free) would be left the old size or written to the wrong key.
+        problem = exchange.missing_shape_keys(self.obj.data, self.data, self.result)
+        if problem:
+            raise Error(f"{self.obj.name}: {problem}; nothing was written")
 
     def write(self):
         if self.result is not None:
             if self.edit:
                 # A stand-in object lets the vertex groups be rebuilt on the scratch mesh, in
-                # the object's order, before the edit mesh loads it.
+                # the object's order, before the edit mesh loads it (a copy of the object's
+                # mesh names its groups already).
                 stand_in = bpy.data.objects.new("hedge scratch", self.scratch)
                 bpy.context.scene.collection.objects.link(stand_in)
                 try:
                     for name in self.data.vertex_groups:
-                        stand_in.vertex_groups.new(name=name)
+                        if name not in stand_in.vertex_groups:
+                            stand_in.vertex_groups.new(name=name)
                     messages = exchange.write_mesh(self.scratch, self.data, self.result, obj=stand_in)
                 finally:
                     bpy.data.objects.remove(stand_in)
                 bm = bmesh.from_edit_mesh(self.obj.data)
                 bm.clear()
-                bm.from_mesh(self.scratch)
+                if self.data.shape_keys:
+                    # As entering Edit Mode does: a shape layer per key block, the vertices at
+                    # the active key's shape.
+                    bm.from_mesh(self.scratch, use_shape_key=True, shape_key_index=self.obj.active_shape_key_index)
+                else:
+                    bm.from_mesh(self.scratch)
                 bmesh.update_edit_mesh(self.obj.data, loop_triangles=True, destructive=True)
                 # clear() unlinks the edit mesh from its Python wrapper, which a script may
                 # hold (from_edit_mesh hands out one wrapper): left so, it would outlive the
@@ -129,7 +150,7 @@ def run_targets(op_id, target_list, params, progress=None):
     n = len(target_list)
     try:
         for i, t in enumerate(target_list):
-            soup = t.read()
+            soup = t.read(op)
             step = None
             if progress is not None:
                 def step(fraction, stage, i=i):

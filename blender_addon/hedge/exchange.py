@@ -13,6 +13,8 @@
 #   vertex bevel weight          vertex "bevel_weight"      f32 (3.x; from 4.0 attr:bevel_weight_vert)
 #   vertex identity              vertex "blender:vertex"    i32 (where each result vertex came from)
 #   each vertex group            vertex "vgroup:<name>"     f32 weight (0 where not a member)
+#   each shape key but the basis vertex "shape:<key name>"  f32 x3, the key's offset from the
+#                                                           reference key (the basis)
 # Edge data (seams, sharp edges, creases, bevel weights, generic edge attributes) has no
 # channel: it is matched back by the pair of source vertices of each result edge.
 #
@@ -21,8 +23,11 @@
 # attributes (bevel_weight_vert, bevel_weight_edge, crease_vert, crease_edge, sharp_edge,
 # uv_seam), which the generic attribute path carries like any other; 3.x keeps them as
 # properties behind has_* tests. Each datum is read once, by one path.
+import bmesh
 import bpy
 import numpy as np
+
+from .native import Error
 
 # Blender attribute type -> (foreach property, numpy dtype, components)
 # (a type the running Blender lacks never occurs: 3.4 has the first eight types below, 4.3 adds
@@ -92,6 +97,7 @@ class MeshData:
         self.not_carried = []     # what could not cross, for the report
         self.vertex_groups = []   # names, in order, when read (read_vertex_groups)
         self.active_group = -1
+        self.shape_keys = []      # key block names in order, the reference key first (read_shape_keys)
 
 
 def read_mesh(me):
@@ -247,6 +253,90 @@ def read_vertex_groups(obj, me, data):
         if temp is not None:
             bpy.data.objects.remove(temp)
         bpy.data.node_groups.remove(tree)
+
+
+SHAPE_PREFIX = "shape:"
+
+
+def read_shape_keys(me, data):
+    """Adds each shape key of `me` but the reference key (the basis) as a vertex channel
+    holding the key's offset from the basis, and makes the basis the positions. Offsets, not
+    coordinates: an operation that moves or replaces a vertex moves the basis, and the
+    interpolated offset added to the new basis keeps the key's deformation (a dent stays a
+    dent where the surface went). Relative and absolute keys alike: each is rebuilt as
+    basis + offset, whatever it is relative to."""
+    key = me.shape_keys
+    if key is None or len(key.key_blocks) == 0:
+        return
+    nv = len(data.soup["positions"])
+    reference = key.reference_key
+    for block in key.key_blocks:
+        if len(block.data) != nv:
+            raise Error(f"shape key '{block.name}' of {me.name} has {len(block.data)} points for {nv} vertices; "
+                        f"the mesh and its shape keys disagree (apply or remove the keys)")
+    basis = _get(reference.data, "co", nv, np.float32, 3)
+    for block in key.key_blocks:
+        co = basis if block == reference else _get(block.data, "co", nv, np.float32, 3)
+        if not np.isfinite(co).all():
+            raise Error(f"shape key '{block.name}' of {me.name} has NaN or infinite coordinates")
+        if block != reference:
+            data.soup["channels"].append((SHAPE_PREFIX + block.name, "vertex", co - basis))
+    # In Edit Mode the mesh read holds the active key's shape; the basis is what keys are
+    # relative to (and what Object Mode shows with every key at 0).
+    data.soup["positions"] = basis
+    data.shape_keys = [block.name for block in key.key_blocks]
+
+
+def missing_shape_keys(me, data, result):
+    """What stops the result's keys from being written: the keys changed since they were
+    read (names or order), or a key's channel did not come back. None when all is well."""
+    key = me.shape_keys
+    names = [block.name for block in key.key_blocks] if key is not None else []
+    if names != data.shape_keys:  # keys read as none when the mesh had none
+        return "its shape keys changed while Hedge ran"
+    lost = [name for name in names[1:] if channel(result, SHAPE_PREFIX + name, "vertex") is None]
+    if lost:
+        return "shape keys " + ", ".join(repr(name) for name in lost) + " did not come through"
+    return None
+
+
+def _resize_key_blocks(me, n):
+    """Gives every key block of `me` n points while keeping the Key data-block, so the key
+    blocks' settings, relative keys, drivers and animation (which address key blocks by
+    name) all stay. Writing a BMesh into the mesh is the only way Blender resizes key
+    blocks; a BMesh made from the mesh itself has shape layers tied to the key blocks, so
+    Blender resizes them without falling back (and warning). The mesh keeps n loose
+    vertices: its geometry is rebuilt right after."""
+    old = len(me.vertices)
+    me.clear_geometry()
+    me.vertices.add(old)  # vertices only: the key blocks still fit, the BMesh is cheap
+    bm = bmesh.new()
+    try:
+        bm.from_mesh(me)
+        if old == 0:
+            for _ in range(n):  # nothing to duplicate (an empty mesh with keys)
+                bm.verts.new()
+        while len(bm.verts) < n:  # doubling: a few bulk duplications, no loop per vertex
+            bm.verts.ensure_lookup_table()
+            bmesh.ops.duplicate(bm, geom=bm.verts[:n - len(bm.verts)])
+        if len(bm.verts) > n:
+            bm.verts.ensure_lookup_table()
+            bmesh.ops.delete(bm, geom=bm.verts[n:], context='VERTS')
+        bm.to_mesh(me)
+    finally:
+        bm.free()
+
+
+def write_shape_keys(me, data, result):
+    """Sets every key block from the result: the reference key at the result's positions,
+    every other key at positions + its carried offset."""
+    key = me.shape_keys
+    positions = result["positions"]
+    for block in key.key_blocks:
+        if block == key.reference_key:
+            _set(block.data, "co", positions)
+        else:
+            _set(block.data, "co", positions + channel(result, SHAPE_PREFIX + block.name, "vertex"))
 
 
 def write_vertex_groups(obj, me, data, result):
@@ -420,11 +510,16 @@ def write_mesh(me, data, result, rebuild=False, obj=None):
     """Writes a result dict into `me`. Same topology: in place (unless `rebuild`). Otherwise
     the geometry is rebuilt and every layer recreated from its channel; vertex groups too
     when `obj` (an object using `me`) is given."""
+    keyed = bool(data.shape_keys)
     if not rebuild and same_topology(data.soup, result):
         _write_channels_in_place(me, data, result)
+        if keyed:
+            write_shape_keys(me, data, result)
         me.update()
         return []
     positions = result["positions"]
+    if keyed:
+        _resize_key_blocks(me, len(positions))
     sizes = result["face_sizes"]
     corners = result["corners"]
     nv, nf, nc = len(positions), len(sizes), len(corners)
@@ -444,6 +539,8 @@ def write_mesh(me, data, result, rebuild=False, obj=None):
     _write_edges(me, data, result)
     if obj is not None:
         write_vertex_groups(obj, me, data, result)
+    if keyed:
+        write_shape_keys(me, data, result)
     messages = [f"Blender: not carried: {what}" for what in data.not_carried]
     bad = repeated_vertex_faces(sizes, corners)
     if bad:

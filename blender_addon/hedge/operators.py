@@ -19,11 +19,13 @@ abandoned = []
 def reap_abandoned():
     abandoned[:] = [job for job in abandoned if not job.done()]
 
-# What the Blender exchange does not carry, said in every tooltip of a changing operation.
-NOT_CARRIED = ("Not carried when the connectivity changes: shape keys (such meshes are refused), custom "
-               "split normals, loose edges. Vertex group weights are interpolated (weight 0 leaves "
-               "the group); seams, sharp edges and creases follow edges whose ends both come from "
-               "the vertices of such an edge")
+# What the Blender exchange carries and does not, said in every tooltip of a changing operation.
+EXCHANGE_NOTE = ("Shape keys follow: each key's offset from the basis (reference key) is carried like an "
+               "attribute and added back to the new basis, on the same keys, so names, order, settings, "
+               "relative keys, drivers and animation stay; absolute keys alike. Not carried when the "
+               "connectivity changes: custom split normals, loose edges. Vertex group weights are "
+               "interpolated (weight 0 leaves the group); seams, sharp edges and creases follow edges whose "
+               "ends both come from the vertices of such an edge")
 
 
 def first_paragraph(text):
@@ -118,7 +120,7 @@ class HedgeOperator:
         self._index += 1
         if self._index < len(self._targets):
             t = self._targets[self._index]
-            self._job = require_native().Job(self.operation["id"], t.read(), self.params())
+            self._job = require_native().Job(self.operation["id"], t.read(self.operation), self.params())
 
     def _release(self):
         for t in self._targets:
@@ -175,7 +177,7 @@ def make_operator(op):
     annotations = {p["id"]: make_property(p) for p in op["params"]}
     description = first_paragraph(op["help"])
     if op["changes_mesh"]:
-        description = description.rstrip(".") + ". " + NOT_CARRIED
+        description = description.rstrip(".") + ". " + EXCHANGE_NOTE
     return type(f"MESH_OT_hedge_{op['id']}", (HedgeOperator, bpy.types.Operator), {
         "bl_idname": f"mesh.hedge_{op['id']}",
         "bl_label": op["title"],
