@@ -94,14 +94,25 @@ class BadInputTest(unittest.TestCase):
         with self.assertRaises(hedge.Error):
             hedge.run(obj, "smooth")
 
-    def test_shape_keys_refused_when_vertices_change(self):
+    def test_broken_shape_keys_refused(self):
+        # Keys follow every operation (test_shape_keys); keys with a NaN are refused, unchanged.
         obj = object_from("keyed", [(0, 0, 0), (1, 0, 0), (0, 1, 0), (1, 1, 0)], [], [(0, 1, 3, 2)])
         obj.shape_key_add(name="Basis")
-        obj.shape_key_add(name="Key 1")
+        key = obj.shape_key_add(name="Key 1")
+        co = np.array([0, 0, 0, 1, 0, 0, 0, np.inf, 0, 1, 1, 0], np.float32)
+        key.data.foreach_set("co", co)  # not clamped to the property's range, as data[2].co = ... is
+        before = mesh_arrays(obj.data)
         result, error = call("subdivide", scheme='midpoint')
-        self.assertIn("shape keys", error)
-        self.assertEqual(len(obj.data.vertices), 4)
-        self.assertEqual(call("smooth", preserve_boundary=False)[0], {'FINISHED'})
+        self.assertIn("shape key 'Key 1'", error)
+        self.assertIn("NaN or infinite", error)
+        after = mesh_arrays(obj.data)
+        for k in before:
+            self.assertTrue(np.array_equal(before[k], after[k]), k)
+        self.assertEqual(len(obj.data.shape_keys.key_blocks["Key 1"].data), 4)
+        co[7] = 1
+        key.data.foreach_set("co", co)
+        self.assertEqual(call("subdivide", scheme='midpoint')[0], {'FINISHED'})
+        self.assertEqual(len(obj.data.shape_keys.key_blocks["Key 1"].data), len(obj.data.vertices))
 
     def test_out_of_range_properties(self):
         obj = nasty()
