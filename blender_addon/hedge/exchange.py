@@ -303,25 +303,22 @@ def missing_shape_keys(me, data, result):
 def _resize_key_blocks(me, n):
     """Gives every key block of `me` n points while keeping the Key data-block, so the key
     blocks' settings, relative keys, drivers and animation (which address key blocks by
-    name) all stay. Writing a BMesh into the mesh is the only way Blender resizes key
+    name) all stay. Writing a BMesh into the mesh is the only way the API resizes key
     blocks; a BMesh made from the mesh itself has shape layers tied to the key blocks, so
-    Blender resizes them without falling back (and warning). The mesh keeps n loose
+    Blender resizes them without falling back (and warning). The mesh is left with n loose
     vertices: its geometry is rebuilt right after."""
     old = len(me.vertices)
     me.clear_geometry()
-    me.vertices.add(old)  # vertices only: the key blocks still fit, the BMesh is cheap
+    # Vertices only, no more than the key blocks hold: the BMesh reads that many points.
+    me.vertices.add(min(old, n))
     bm = bmesh.new()
     try:
         bm.from_mesh(me)
-        if old == 0:
-            for _ in range(n):  # nothing to duplicate (an empty mesh with keys)
-                bm.verts.new()
-        while len(bm.verts) < n:  # doubling: a few bulk duplications, no loop per vertex
-            bm.verts.ensure_lookup_table()
-            bmesh.ops.duplicate(bm, geom=bm.verts[:n - len(bm.verts)])
-        if len(bm.verts) > n:
-            bm.verts.ensure_lookup_table()
-            bmesh.ops.delete(bm, geom=bm.verts[n:], context='VERTS')
+        # The vertices the result has more of; one by one is the fastest way (0.4 s a million;
+        # bmesh.ops.create_circle takes 0.7 s, duplicate 4 s).
+        new_vertex = bm.verts.new
+        for _ in range(n - len(bm.verts)):
+            new_vertex()
         bm.to_mesh(me)
     finally:
         bm.free()
