@@ -1,7 +1,8 @@
 # GUI smoke test under Xvfb: Blender starts with the add-on enabled, the Hedge tab of the 3D
 # View sidebar is found (3.4 has no API to choose a tab: simulated clicks walk the tab strip
 # until the panel draws), an operator runs interactively (modal, with progress) and Esc
-# cancels a long one leaving the mesh as it was; screenshots are saved with the test output.
+# cancels a long one leaving the mesh as it was, shape keys follow an interactive run and a key
+# renamed during one is refused; screenshots are saved with the test output.
 #   xvfb-run -a -s "-screen 0 1600x1000x24" blender --factory-startup --enable-event-simulate \
 #            --python test_gui.py -- --zip ZIP --out DIR
 import os
@@ -194,6 +195,40 @@ def steps():
     log(f"after Esc: {len(obj.data.polygons)} faces (before {n_before})")
     assert len(obj.data.polygons) == n_before and np.array_equal(co_before, co_after), "Esc did not leave the mesh"
     screenshot("gui_after_cancel.png")
+
+    # Shape keys through the interactive run; a key renamed while a run works is refused when
+    # it ends (the key blocks would not match), the mesh unchanged.
+    obj.hide_set(True)
+    bpy.ops.mesh.primitive_uv_sphere_add(location=(0, 0, 0))
+    sphere = bpy.context.active_object
+    sphere.shape_key_add(name="Basis")
+    dent = sphere.shape_key_add(name="Dent", from_mix=False)
+    co = np.empty(len(sphere.data.vertices) * 3, np.float32)
+    dent.data.foreach_get("co", co)
+    dent.data.foreach_set("co", co * 0.9)
+    sphere_faces = len(sphere.data.polygons)
+    with bpy.context.temp_override(window=win, area=area, region=region(area, 'WINDOW')):
+        bpy.ops.mesh.hedge_decimate('INVOKE_DEFAULT', target_ratio=0.25)
+    for _ in range(100):
+        yield 0.2
+        if not operators.running:
+            break
+    keys = sphere.data.shape_keys.key_blocks
+    log(f"keyed decimate: {len(sphere.data.vertices)} vertices, keys {[(k.name, len(k.data)) for k in keys]}")
+    assert len(sphere.data.polygons) < sphere_faces / 2 and all(len(k.data) == len(sphere.data.vertices) for k in keys)
+    vertices = len(sphere.data.vertices)
+    with bpy.context.temp_override(window=win, area=area, region=region(area, 'WINDOW')):
+        bpy.ops.mesh.hedge_remesh('INVOKE_DEFAULT', target_edge_length=0.02, iterations=20)
+    yield 0.2
+    assert "remesh" in operators.running, "the keyed remesh finished at once"
+    keys["Dent"].name = "Renamed"
+    for _ in range(600):
+        yield 0.2
+        if not operators.running:
+            break
+    log(f"key renamed during the run: {hedge.api.last_errors.get('remesh')}")
+    assert "shape keys changed" in hedge.api.last_errors.get("remesh", ""), "the renamed key was not noticed"
+    assert len(sphere.data.vertices) == vertices and len(keys["Renamed"].data) == vertices
 
 
 def driver():
