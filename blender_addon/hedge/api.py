@@ -45,13 +45,13 @@ class Target:
     def read(self, op=None):
         """Reads the mesh into a soup for `op` (its shape keys too when `op` changes the mesh)."""
         me = self.obj.data
-        keys = me.shape_keys is not None and (op is None or op["changes_mesh"])
+        carry_keys = me.shape_keys is not None and (op is None or op["changes_mesh"])
         if self.edit:
             # The edit mesh is the truth in Edit Mode: work on a copy, load it back after.
             # Loading it into the object's mesh first also writes its shape layers into the
             # key blocks, which are read from there.
             self.obj.update_from_editmode()  # the weights are read from the object's mesh
-            if keys:
+            if carry_keys:
                 # A copy keeps the key blocks (with the ids that tie them to the edit mesh's
                 # shape layers), for the result to be loaded back with them.
                 self.scratch = me.copy()
@@ -62,7 +62,7 @@ class Target:
             me = self.scratch
         self.data = exchange.read_mesh(me)
         exchange.read_vertex_groups(self.obj, self.obj.data, self.data)
-        if keys:
+        if carry_keys:
             exchange.read_shape_keys(me, self.data)
         return self.data.soup
 

@@ -20,12 +20,13 @@ def reap_abandoned():
     abandoned[:] = [job for job in abandoned if not job.done()]
 
 # What the Blender exchange carries and does not, said in every tooltip of a changing operation.
-EXCHANGE_NOTE = ("Shape keys follow: each key's offset from the basis (reference key) is carried like an "
-               "attribute and added back to the new basis, on the same keys, so names, order, settings, "
-               "relative keys, drivers and animation stay; absolute keys alike. Not carried when the "
-               "connectivity changes: custom split normals, loose edges. Vertex group weights are "
-               "interpolated (weight 0 leaves the group); seams, sharp edges and creases follow edges whose "
-               "ends both come from the vertices of such an edge")
+EXCHANGE_NOTE = ("Shape keys follow: each key is carried as its offset from the basis (the reference key), "
+                 "interpolated like an attribute, and rebuilt as the new basis plus that offset, so keys "
+                 "relative to other keys and absolute keys deform as before; the same keys stay, with their "
+                 "names, order, settings, drivers and animation. Not carried when the connectivity changes: "
+                 "custom split normals, loose edges. Vertex group weights are interpolated (weight 0 leaves "
+                 "the group); seams, sharp edges and creases follow edges whose ends both come from the "
+                 "vertices of such an edge")
 
 
 def first_paragraph(text):
@@ -53,6 +54,13 @@ def make_property(p):
 class HedgeOperator:
     """Shared by the generated operators; `operation` is the catalogue entry."""
     operation = None
+    full_description = ""
+
+    @classmethod
+    def description(cls, context, properties):
+        # The whole text for the tooltip: Blender cuts bl_description (to 239 characters in
+        # 3.4, 1023 later), and an operation's help with the exchange note is longer.
+        return cls.full_description
 
     @classmethod
     def poll(cls, context):
@@ -182,6 +190,7 @@ def make_operator(op):
         "bl_idname": f"mesh.hedge_{op['id']}",
         "bl_label": op["title"],
         "bl_description": description,
+        "full_description": description,
         "bl_options": {'REGISTER', 'UNDO'},
         "__annotations__": annotations,
         "operation": op,

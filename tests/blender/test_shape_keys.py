@@ -402,6 +402,14 @@ class ShapeKeysTest(unittest.TestCase):
             for key_name, co in shapes.items():
                 self.assertTrue(np.allclose(key_shape(me, key_name), co, atol=1e-6), key_name)
 
+    def test_help_says_what_happens_to_keys(self):
+        for op_id in changing_operations():
+            # The tooltip's text (bl_description is cut short by Blender).
+            operator = bpy.types.Operator.bl_rna_get_subclass_py(f"MESH_OT_hedge_{op_id}")
+            description = operator.description(bpy.context, None)
+            for words in ("offset from the basis", "relative to other keys", "drivers and animation"):
+                self.assertIn(words, description, op_id)
+
     def test_several_runs_leave_no_data_behind(self):
         obj = keyed_sphere(24, 12)
         keys, meshes = len(bpy.data.shape_keys), len(bpy.data.meshes)
