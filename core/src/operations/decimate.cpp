@@ -14,6 +14,7 @@
 
 #include "hedge/distance.h"
 #include "hedge/error.h"
+#include "hedge/limits.h"
 #include "hedge/geometry.h"
 #include "binding.h"
 #include "parallel.h"
@@ -1256,7 +1257,7 @@ Operation decimate_operation() {
   using R = DecimateReport;
   return Binding<O, R>("decimate", "Decimate", Category::remeshing, help, decimate)
       .fixed(&O::keep_input_on_failure, false)
-      .option(&O::target_faces, "target_faces", "Target faces", at_least(0),
+      .option(&O::target_faces, "target_faces", "Target faces", between(0, kMaxCorners),  // 32-bit indices
               "Number of triangles to reach; 0 uses the target ratio instead. On a closed surface an "
               "odd count stops one above it, since a collapse there removes two triangles.")
       .option(&O::target_ratio, "target_ratio", "Target ratio", between(0, 1),

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "hedge/error.h"
+#include "hedge/limits.h"
 #include "hedge/provenance.h"
 #include "hedge/topology.h"
 #include "binding.h"
@@ -813,7 +814,7 @@ Operation fill_holes_operation() {
   using O = FillHolesOptions;
   using R = FillHolesReport;
   return Binding<O, R>("fill_holes", "Fill Holes", Category::cleaning, help, fill_holes)
-      .option(&O::max_hole_edges, "max_hole_edges", "Max hole size (edges)", at_least(0),
+      .option(&O::max_hole_edges, "max_hole_edges", "Max hole size (edges)", between(0, kMaxCorners),
               "Holes with more boundary edges are left open and reported; 0 fills every hole.")
       .option(&O::refine, "refine", "Refine patch",
               "Split and relax the new triangles until they are sized like their surroundings.")
