@@ -17,7 +17,6 @@ enum class SmoothingMethod {
 };
 
 //! "uniform", "cotangent", "taubin"; throws Error naming the choices otherwise.
-SmoothingMethod smoothing_method_from_name(const std::string& name);
 const char* smoothing_method_name(SmoothingMethod method);
 
 struct SmoothOptions {

@@ -3,7 +3,6 @@
 #pragma once
 
 #include <cstddef>
-#include <string>
 
 #include "hedge/mesh.h"
 #include "hedge/progress.h"
@@ -18,7 +17,6 @@ enum class SubdivisionScheme {
 };
 
 //! "loop", "catmull_clark", "sqrt3", "midpoint"; throws Error naming the choices otherwise.
-SubdivisionScheme subdivision_scheme_from_name(const std::string& name);
 const char* subdivision_scheme_name(SubdivisionScheme scheme);
 
 struct SubdivideOptions {

@@ -3,7 +3,6 @@
 #pragma once
 
 #include <cstddef>
-#include <string>
 
 #include "hedge/mesh.h"
 #include "hedge/progress.h"
@@ -21,7 +20,6 @@ enum class TriangulationMethod {
 };
 
 //! "min_area", "ear_clipping"; throws Error naming the choices otherwise.
-TriangulationMethod triangulation_method_from_name(const std::string& name);
 const char* triangulation_method_name(TriangulationMethod method);
 
 struct TriangulateOptions {

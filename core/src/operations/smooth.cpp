@@ -10,9 +10,9 @@
 #include <thread>
 #include <vector>
 
+#include "binding.h"
 #include "hedge/error.h"
 #include "hedge/normals.h"
-#include "binding.h"
 #include "parallel.h"
 
 namespace hedge {
@@ -75,32 +75,28 @@ double clamped_cot(const Vec3d& u, const Vec3d& v) {
 //! below. Polygons see the edge from their centroid.
 void cotangent_weights(const Mesh& m, const std::vector<Vec3d>& p, const std::vector<Vec3d>& centroid,
                        std::vector<double>& weight, unsigned threads) {
-  parallel_for(m.edges_size(), threads, [&](std::size_t lo, std::size_t hi) {
-    for (Index e = Index(lo); e < hi; ++e) {
-      if (m.is_deleted(Edge(e))) continue;
-      double w = 0;
-      for (unsigned side = 0; side < 2; ++side) {
-        const Halfedge h = Mesh::halfedge(Edge(e), side);
-        const Face f = m.face(h);
-        if (!f.is_valid()) continue;
-        const Halfedge n = m.next(h);
-        const bool triangle = m.next(m.next(n)) == h;
-        const Vec3d& apex = triangle ? p[m.to_vertex(n).idx()] : centroid[f.idx()];
-        w += 0.5 * clamped_cot(p[m.from_vertex(h).idx()] - apex, p[m.to_vertex(h).idx()] - apex);
-      }
-      weight[e] = std::max(0.0, w);
-    }
-  }, kSmoothGrain);
+  parallel_for(
+      m.edges_size(), threads,
+      [&](std::size_t lo, std::size_t hi) {
+        for (Index e = Index(lo); e < hi; ++e) {
+          if (m.is_deleted(Edge(e))) continue;
+          double w = 0;
+          for (unsigned side = 0; side < 2; ++side) {
+            const Halfedge h = Mesh::halfedge(Edge(e), side);
+            const Face f = m.face(h);
+            if (!f.is_valid()) continue;
+            const Halfedge n = m.next(h);
+            const bool triangle = m.next(m.next(n)) == h;
+            const Vec3d& apex = triangle ? p[m.to_vertex(n).idx()] : centroid[f.idx()];
+            w += 0.5 * clamped_cot(p[m.from_vertex(h).idx()] - apex, p[m.to_vertex(h).idx()] - apex);
+          }
+          weight[e] = std::max(0.0, w);
+        }
+      },
+      kSmoothGrain);
 }
 
 }  // namespace
-
-SmoothingMethod smoothing_method_from_name(const std::string& name) {
-  if (name == "uniform") return SmoothingMethod::uniform;
-  if (name == "cotangent") return SmoothingMethod::cotangent;
-  if (name == "taubin") return SmoothingMethod::taubin;
-  throw Error("smooth: unknown method '" + name + "'; the methods are uniform, cotangent, taubin");
-}
 
 const char* smoothing_method_name(SmoothingMethod method) {
   switch (method) {
@@ -158,30 +154,33 @@ SmoothReport smooth(Mesh& mesh, const SmoothOptions& options, Progress& progress
   }
 
   auto step = [&](double amount, bool weighted) {
-    parallel_for(V, options.threads, [&](std::size_t lo, std::size_t hi) {
-      for (std::size_t v = lo; v < hi; ++v) {
-        const Index b = rings.offset[v], e = rings.offset[v + 1];
-        if (b == e) {
-          next[v] = current[v];
-          continue;
-        }
-        Vec3d sum{};
-        double total = 0;
-        if (weighted && !rings.curve[v]) {
-          for (Index k = b; k < e; ++k) {
-            const double w = weight[rings.edge[k]];
-            sum += current[rings.neighbour[k]] * w;
-            total += w;
+    parallel_for(
+        V, options.threads,
+        [&](std::size_t lo, std::size_t hi) {
+          for (std::size_t v = lo; v < hi; ++v) {
+            const Index b = rings.offset[v], e = rings.offset[v + 1];
+            if (b == e) {
+              next[v] = current[v];
+              continue;
+            }
+            Vec3d sum{};
+            double total = 0;
+            if (weighted && !rings.curve[v]) {
+              for (Index k = b; k < e; ++k) {
+                const double w = weight[rings.edge[k]];
+                sum += current[rings.neighbour[k]] * w;
+                total += w;
+              }
+            }
+            if (total <= 0) {  // uniform, or all cotangent weights vanished
+              sum = Vec3d{};
+              for (Index k = b; k < e; ++k) sum += current[rings.neighbour[k]];
+              total = double(e - b);
+            }
+            next[v] = current[v] + (sum / total - current[v]) * amount;
           }
-        }
-        if (total <= 0) {  // uniform, or all cotangent weights vanished
-          sum = Vec3d{};
-          for (Index k = b; k < e; ++k) sum += current[rings.neighbour[k]];
-          total = double(e - b);
-        }
-        next[v] = current[v] + (sum / total - current[v]) * amount;
-      }
-    }, kSmoothGrain);
+        },
+        kSmoothGrain);
     current.swap(next);
   };
 
@@ -254,16 +253,16 @@ Operation smooth_operation() {
               "λ: how far each step moves a vertex toward the mean (0 to 1)")
       .option(&O::preserve_boundary, "preserve_boundary", "Preserve boundary",
               "keep boundary vertices fixed (otherwise smooth them along the boundary)")
-      .result("method", [](const O& o, const R&) -> std::optional<Value> {
-        return std::string(smoothing_method_name(o.method));
-      })
+      .result("method",
+              [](const O& o, const R&) -> std::optional<Value> { return std::string(smoothing_method_name(o.method)); })
       .result(&R::iterations, "iterations")
       .result(&R::moved_vertices, "moved_vertices")
       .result(&R::lambda, "lambda")
-      .result("mu", [](const O& o, const R& r) -> std::optional<Value> {
-        if (o.method != SmoothingMethod::taubin) return std::nullopt;
-        return r.mu;
-      })
+      .result("mu",
+              [](const O& o, const R& r) -> std::optional<Value> {
+                if (o.method != SmoothingMethod::taubin) return std::nullopt;
+                return r.mu;
+              })
       .result(&R::mean_displacement, "mean_displacement")
       .result(&R::max_displacement, "max_displacement")
       .messages([](const O&, const R& r) {

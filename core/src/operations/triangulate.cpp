@@ -10,13 +10,14 @@
 #include <limits>
 #include <numbers>
 #include <optional>
+#include <string>
 #include <unordered_map>
 #include <unordered_set>
 #include <utility>
 #include <vector>
 
-#include "hedge/error.h"
 #include "binding.h"
+#include "hedge/error.h"
 
 namespace hedge {
 namespace {
@@ -407,12 +408,6 @@ class Cutter {
 
 }  // namespace
 
-TriangulationMethod triangulation_method_from_name(const std::string& name) {
-  if (name == "min_area") return TriangulationMethod::min_area;
-  if (name == "ear_clipping") return TriangulationMethod::ear_clipping;
-  throw Error("triangulate: unknown method '" + name + "'; the methods are min_area, ear_clipping");
-}
-
 const char* triangulation_method_name(TriangulationMethod method) {
   switch (method) {
     case TriangulationMethod::min_area:
@@ -485,9 +480,9 @@ Operation triangulate_operation() {
       .choice(&O::method, "method", "Method", {TriangulationMethod::min_area, TriangulationMethod::ear_clipping},
               triangulation_method_name,
               "min_area for the best triangles (dynamic programming), ear_clipping for speed")
-      .result("method", [](const O& o, const R&) -> std::optional<Value> {
-        return std::string(triangulation_method_name(o.method));
-      })
+      .result(
+          "method",
+          [](const O& o, const R&) -> std::optional<Value> { return std::string(triangulation_method_name(o.method)); })
       .result(&R::polygons, "polygons")
       .result(&R::triangles, "triangles")
       .result(&R::ear_clipped, "ear_clipped")
