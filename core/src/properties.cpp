@@ -9,31 +9,45 @@ namespace hedge {
 std::size_t scalar_size(ScalarType type) {
   switch (type) {
     case ScalarType::i8:
-    case ScalarType::u8: return 1;
+    case ScalarType::u8:
+      return 1;
     case ScalarType::i16:
-    case ScalarType::u16: return 2;
+    case ScalarType::u16:
+      return 2;
     case ScalarType::f32:
     case ScalarType::i32:
-    case ScalarType::u32: return 4;
+    case ScalarType::u32:
+      return 4;
     case ScalarType::f64:
     case ScalarType::i64:
-    case ScalarType::u64: return 8;
+    case ScalarType::u64:
+      return 8;
   }
   return 0;
 }
 
 const char* scalar_name(ScalarType type) {
   switch (type) {
-    case ScalarType::f32: return "float32";
-    case ScalarType::f64: return "float64";
-    case ScalarType::i8: return "int8";
-    case ScalarType::u8: return "uint8";
-    case ScalarType::i16: return "int16";
-    case ScalarType::u16: return "uint16";
-    case ScalarType::i32: return "int32";
-    case ScalarType::u32: return "uint32";
-    case ScalarType::i64: return "int64";
-    case ScalarType::u64: return "uint64";
+    case ScalarType::f32:
+      return "float32";
+    case ScalarType::f64:
+      return "float64";
+    case ScalarType::i8:
+      return "int8";
+    case ScalarType::u8:
+      return "uint8";
+    case ScalarType::i16:
+      return "int16";
+    case ScalarType::u16:
+      return "uint16";
+    case ScalarType::i32:
+      return "int32";
+    case ScalarType::u32:
+      return "uint32";
+    case ScalarType::i64:
+      return "int64";
+    case ScalarType::u64:
+      return "uint64";
   }
   return "unknown";
 }
@@ -43,39 +57,8 @@ void ChannelArray::swap_elements(std::size_t a, std::size_t b) {
   std::swap_ranges(element(a), element(a) + stride_, element(b));
 }
 
-namespace {
-template <class T>
-void blend(std::byte* to, const ChannelArray& c, std::span<const Index> from, std::span<const float> weights) {
-  for (int k = 0; k < c.components(); ++k) {
-    double sum = 0;
-    for (std::size_t i = 0; i < from.size(); ++i) {
-      T value;
-      std::memcpy(&value, c.element(from[i]) + k * sizeof(T), sizeof(T));
-      sum += static_cast<double>(value) * weights[i];
-    }
-    T out = static_cast<T>(sum);
-    std::memcpy(to + k * sizeof(T), &out, sizeof(T));
-  }
-}
-}  // namespace
-
 void ChannelArray::interpolate(std::size_t to, std::span<const Index> from, std::span<const float> weights) {
-  if (from.empty()) return;
-  // Only real numbers blend; integer channels (ids, flags, 8-bit colours) take the value of
-  // the heaviest source. Written in place, without a buffer (this runs once per collapse or
-  // split): blend() reads component k of every source before it writes component k, so
-  // `to` may be one of the sources.
-  switch (scalar_) {
-    case ScalarType::f32:
-      blend<float>(element(to), *this, from, weights);
-      break;
-    case ScalarType::f64:
-      blend<double>(element(to), *this, from, weights);
-      break;
-    default:
-      std::memmove(element(to), element(from[detail::largest_weight(weights)]), stride_);
-      break;
-  }
+  detail::blend_element(*this, from, weights, element(to));
 }
 
 void ChannelArray::permute(std::span<const Index> new_to_old) {

@@ -71,7 +71,8 @@ struct is_interpolable<Vec<T, N>> : std::is_floating_point<T> {};
 template <class T>
 inline constexpr bool is_interpolable_v = is_interpolable<T>::value;
 
-inline std::size_t largest_weight(std::span<const float> weights) {
+template <class W>
+std::size_t largest_weight(std::span<const W> weights) {
   std::size_t best = 0;
   for (std::size_t i = 1; i < weights.size(); ++i)
     if (weights[i] > weights[best]) best = i;
@@ -136,7 +137,9 @@ class TypedArray final : public PropertyArray {
 class ChannelArray final : public PropertyArray {
  public:
   ChannelArray(std::string name, ScalarType scalar, int components)
-      : PropertyArray(std::move(name)), scalar_(scalar), components_(components),
+      : PropertyArray(std::move(name)),
+        scalar_(scalar),
+        components_(components),
         stride_(scalar_size(scalar) * static_cast<std::size_t>(components)) {}
 
   ScalarType scalar() const { return scalar_; }
@@ -169,6 +172,39 @@ class ChannelArray final : public PropertyArray {
   std::size_t stride_;
   std::vector<std::byte> data_;
 };
+
+namespace detail {
+template <class T, class W>
+void blend_reals(const ChannelArray& src, std::span<const Index> from, std::span<const W> weights, std::byte* to) {
+  for (int k = 0; k < src.components(); ++k) {
+    double sum = 0;
+    for (std::size_t i = 0; i < from.size(); ++i) {
+      T value;
+      std::memcpy(&value, src.element(from[i]) + k * sizeof(T), sizeof(T));
+      sum += static_cast<double>(value) * static_cast<double>(weights[i]);
+    }
+    const T out = static_cast<T>(sum);
+    std::memcpy(to + k * sizeof(T), &out, sizeof(T));
+  }
+}
+
+//! The one rule by which a channel element is made from others: real components are weighted
+//! sums (taken in double); integer channels (ids, flags, 8-bit colours) take the heaviest
+//! source's value. Component k of every source is read before component k of `to` is written,
+//! so `to` may be one of the sources. `to` is an element of a channel laid out like `src`.
+template <class W>
+void blend_element(const ChannelArray& src, std::span<const Index> from, std::span<const W> weights, std::byte* to) {
+  if (from.empty()) return;
+  switch (src.scalar()) {
+    case ScalarType::f32:
+      return blend_reals<float>(src, from, weights, to);
+    case ScalarType::f64:
+      return blend_reals<double>(src, from, weights, to);
+    default:
+      std::memmove(to, src.element(from[largest_weight(weights)]), src.stride());
+  }
+}
+}  // namespace detail
 
 //! A typed view of one property of element kind H (Vertex, Halfedge, Edge or Face).
 //! Valid while the property exists; cheap to copy.

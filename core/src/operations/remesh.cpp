@@ -11,11 +11,11 @@
 #include <string>
 #include <vector>
 
+#include "binding.h"
 #include "hedge/distance.h"
 #include "hedge/error.h"
 #include "hedge/geometry.h"
 #include "hedge/provenance.h"
-#include "binding.h"
 #include "parallel.h"
 #include "welded_copies.h"
 
@@ -74,40 +74,6 @@ double surface_area(const Mesh& mesh) {
 template <class F>
 void parallel_for(std::size_t n, F&& work) {
   hedge::parallel_for(n, 0, std::forward<F>(work), 8192);
-}
-
-// Blends element `to` of dst from elements `from` of src (same layout): real numbers are
-// weighted, other types take the value of the heaviest source.
-void blend_channel(const ChannelArray& src, const Index from[3], const double w[3], ChannelArray& dst, Index to) {
-  const int n = src.components();
-  int heaviest = 0;
-  for (int k = 1; k < 3; ++k)
-    if (w[k] > w[heaviest]) heaviest = k;
-  switch (src.scalar()) {
-    case ScalarType::f32: {
-      float out[16];
-      for (int c = 0; c < n && c < 16; ++c) {
-        double s = 0;
-        for (int k = 0; k < 3; ++k) s += w[k] * reinterpret_cast<const float*>(src.element(from[k]))[c];
-        out[c] = static_cast<float>(s);
-      }
-      if (n <= 16) std::memcpy(dst.element(to), out, sizeof(float) * std::size_t(n));
-      break;
-    }
-    case ScalarType::f64: {
-      double out[16];
-      for (int c = 0; c < n && c < 16; ++c) {
-        double s = 0;
-        for (int k = 0; k < 3; ++k) s += w[k] * reinterpret_cast<const double*>(src.element(from[k]))[c];
-        out[c] = s;
-      }
-      if (n <= 16) std::memcpy(dst.element(to), out, sizeof(double) * std::size_t(n));
-      break;
-    }
-    default:
-      std::memcpy(dst.element(to), src.element(from[heaviest]), src.stride());
-      break;
-  }
 }
 
 class Remesher {
@@ -817,7 +783,8 @@ void Remesher::resample_attributes() {
         from_corners[k] = corners[k].idx();
       }
       for (const Pair& p : vertex_pairs) {
-        blend_channel(*p.from, from_vertices, w, *p.to, v.idx());
+        detail::blend_element(*p.from, std::span<const Index>(from_vertices), std::span<const double>(w),
+                              p.to->element(v.idx()));
         renormalize(p.to, v.idx());
       }
       if (corner_pairs.empty()) continue;
@@ -828,7 +795,8 @@ void Remesher::resample_attributes() {
         if (!first.is_valid()) {
           first = in;
           for (const Pair& p : corner_pairs) {
-            blend_channel(*p.from, from_corners, w, *p.to, in.idx());
+            detail::blend_element(*p.from, std::span<const Index>(from_corners), std::span<const double>(w),
+                                  p.to->element(in.idx()));
             renormalize(p.to, in.idx());
           }
         } else {

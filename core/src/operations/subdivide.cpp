@@ -10,17 +10,18 @@
 #include <exception>
 #include <limits>
 #include <numbers>
+#include <string>
 #include <thread>
 #include <tuple>
 #include <typeinfo>
 #include <vector>
 
+#include "binding.h"
 #include "hedge/error.h"
 #include "hedge/limits.h"
 #include "hedge/normals.h"
 #include "hedge/provenance.h"
 #include "hedge/topology.h"
-#include "binding.h"
 #include "parallel.h"
 #include "welded_copies.h"
 
@@ -74,11 +75,11 @@ class Stencil {
   std::size_t size_ = 0, capacity_ = kInline;
 };
 
-//! A property array with its fast path resolved once (f32 host channels are the common case
-//! and the generic interpolate() allocates per call).
+//! A property array, with its channel view resolved once: host channels (the common case)
+//! blend through detail::blend_element directly, other arrays through interpolate().
 struct Target {
   PropertyArray* array = nullptr;
-  ChannelArray* f32 = nullptr;
+  ChannelArray* channel = nullptr;  // the same array when it is a channel: a direct, inlinable call
   bool internal = false;
 };
 
@@ -96,29 +97,17 @@ std::vector<Target> targets(PropertyContainer& c) {
     Target t;
     t.array = &c.at(i);
     t.internal = t.array->is_internal();
-    if (t.array->type() == typeid(ChannelArray)) {
-      auto* ch = static_cast<ChannelArray*>(t.array);
-      if (ch->scalar() == ScalarType::f32 && ch->components() <= 16) t.f32 = ch;
-    }
+    if (t.array->type() == typeid(ChannelArray)) t.channel = static_cast<ChannelArray*>(t.array);
     out.push_back(t);
   }
   return out;
 }
 
 void blend(const Target& t, std::size_t to, std::span<const Index> index, std::span<const float> weight) {
-  if (t.f32) {
-    const int k = t.f32->components();
-    double sum[16] = {};
-    float value[16];
-    for (std::size_t i = 0; i < index.size(); ++i) {
-      std::memcpy(value, t.f32->element(index[i]), sizeof(float) * std::size_t(k));
-      for (int c = 0; c < k; ++c) sum[c] += double(value[c]) * weight[i];
-    }
-    for (int c = 0; c < k; ++c) value[c] = float(sum[c]);
-    std::memcpy(t.f32->element(to), value, sizeof(float) * std::size_t(k));
-    return;
-  }
-  t.array->interpolate(to, index, weight);
+  if (t.channel)
+    detail::blend_element(*t.channel, index, weight, t.channel->element(to));
+  else
+    t.array->interpolate(to, index, weight);
 }
 
 // Half-edge h (edge e, side s) is cut at the edge point into first(h) (from its origin to
@@ -1199,14 +1188,6 @@ void check_index_limits(const Mesh& mesh, const FaceCensus& census, const Subdiv
 
 }  // namespace
 
-SubdivisionScheme subdivision_scheme_from_name(const std::string& name) {
-  if (name == "loop") return SubdivisionScheme::loop;
-  if (name == "catmull_clark") return SubdivisionScheme::catmull_clark;
-  if (name == "sqrt3") return SubdivisionScheme::sqrt3;
-  if (name == "midpoint") return SubdivisionScheme::midpoint;
-  throw Error("subdivide: unknown scheme '" + name + "'; the schemes are loop, catmull_clark, sqrt3, midpoint");
-}
-
 const char* subdivision_scheme_name(SubdivisionScheme scheme) {
   switch (scheme) {
     case SubdivisionScheme::loop:
@@ -1334,14 +1315,15 @@ Operation subdivide_operation() {
       .option(&O::crease_angle, "crease_angle", "Crease angle", between(0, 180),
               "degrees: edges where the two faces' normals differ by more than this stay sharp (creases "
               "and corners, e.g. a cube's edges at 60); 180 smooths everything")
-      .result("scheme", [](const O& o, const R&) -> std::optional<Value> {
-        return std::string(subdivision_scheme_name(o.scheme));
-      })
+      .result(
+          "scheme",
+          [](const O& o, const R&) -> std::optional<Value> { return std::string(subdivision_scheme_name(o.scheme)); })
       .result(&R::iterations, "iterations")
-      .result("crease_edges", [](const O& o, const R& r) -> std::optional<Value> {
-        if (o.crease_angle >= 180) return std::nullopt;
-        return field_value(r.crease_edges);
-      })
+      .result("crease_edges",
+              [](const O& o, const R& r) -> std::optional<Value> {
+                if (o.crease_angle >= 180) return std::nullopt;
+                return field_value(r.crease_edges);
+              })
       .result(&R::faces_before, "faces_before")
       .result(&R::vertices, "vertices")
       .result(&R::edges, "edges")
