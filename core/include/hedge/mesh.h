@@ -22,6 +22,7 @@
 #include <utility>
 #include <vector>
 
+#include "hedge/detail/memory.h"
 #include "hedge/handles.h"
 #include "hedge/properties.h"
 #include "hedge/vec.h"
@@ -77,10 +78,9 @@ template <Step S, Yield Y>
 class LoopIterator {
  public:
   using difference_type = std::ptrdiff_t;
-  using value_type = std::conditional_t<
-      Y == Yield::halfedge, Halfedge,
-      std::conditional_t<Y == Yield::to_vertex || Y == Yield::from_vertex, Vertex,
-                         std::conditional_t<Y == Yield::edge, Edge, Face>>>;
+  using value_type = std::conditional_t<Y == Yield::halfedge, Halfedge,
+                                        std::conditional_t<Y == Yield::to_vertex || Y == Yield::from_vertex, Vertex,
+                                                           std::conditional_t<Y == Yield::edge, Edge, Face>>>;
   LoopIterator() = default;
   LoopIterator(const Mesh* mesh, Halfedge start, bool at_end)
       : mesh_(mesh), start_(start), current_(start), done_(at_end || !start.is_valid()) {
@@ -97,7 +97,9 @@ class LoopIterator {
     ++*this;
     return copy;
   }
-  bool operator==(const LoopIterator& other) const { return done_ == other.done_ && (done_ || current_ == other.current_); }
+  bool operator==(const LoopIterator& other) const {
+    return done_ == other.done_ && (done_ || current_ == other.current_);
+  }
   Halfedge halfedge() const { return current_; }
 
  private:
@@ -117,30 +119,6 @@ struct LoopRange {
   Halfedge start;
   LoopIterator<S, Y> begin() const { return {mesh, start, false}; }
   LoopIterator<S, Y> end() const { return {mesh, start, true}; }
-};
-
-//! std::allocator, except that an element made without a value (resize(n), emplace_back())
-//! is left unset. The mesh's connectivity arrays use it so that a builder that writes every
-//! field itself (Mesh::resize_unset) does not pay for a fill first: on a big mesh that fill
-//! is one thread taking every page fault of tens of megabytes, which the builder's own
-//! writes, spread over its threads, take anyway.
-template <class T>
-struct UnsetAllocator : std::allocator<T> {
-  static_assert(std::is_trivially_copyable_v<T> && std::is_trivially_destructible_v<T>);
-  using value_type = T;
-  UnsetAllocator() = default;
-  template <class U>
-  UnsetAllocator(const UnsetAllocator<U>&) noexcept {}
-  template <class U>
-  struct rebind {
-    using other = UnsetAllocator<U>;
-  };
-  template <class U>
-  void construct(U*) noexcept {}
-  template <class U, class... Args>
-  void construct(U* p, Args&&... args) {
-    std::construct_at(p, std::forward<Args>(args)...);
-  }
 };
 
 }  // namespace detail
@@ -200,13 +178,13 @@ class Mesh {
   bool is_isolated(Vertex v) const { return !halfedge(v).is_valid(); }
   //! Hints that h's connectivity is about to be read (starts loading it into cache); changes
   //! nothing. Precondition: h is valid.
-  void prefetch(Halfedge h) const { __builtin_prefetch(&halfedges_[h.idx()]); }
+  void prefetch(Halfedge h) const { detail::prefetch(&halfedges_[h.idx()]); }
   //! The same for f's half-edge.
-  void prefetch(Face f) const { __builtin_prefetch(&face_halfedge_[f.idx()]); }
+  void prefetch(Face f) const { detail::prefetch(&face_halfedge_[f.idx()]); }
   //! The same for v's outgoing half-edge and position.
   void prefetch(Vertex v) const {
-    __builtin_prefetch(&vertex_halfedge_[v.idx()]);
-    __builtin_prefetch(&positions_[v.idx()]);
+    detail::prefetch(&vertex_halfedge_[v.idx()]);
+    detail::prefetch(&positions_[v.idx()]);
   }
 
   //! Number of edges at v / corners of f.
@@ -261,10 +239,16 @@ class Mesh {
   //! Outgoing half-edges of v, counter-clockwise (starting at halfedge(v)).
   detail::LoopRange<detail::Step::ccw, detail::Yield::halfedge> outgoing(Vertex v) const { return {this, halfedge(v)}; }
   //! Outgoing half-edges of v, clockwise.
-  detail::LoopRange<detail::Step::cw, detail::Yield::halfedge> outgoing_cw(Vertex v) const { return {this, halfedge(v)}; }
+  detail::LoopRange<detail::Step::cw, detail::Yield::halfedge> outgoing_cw(Vertex v) const {
+    return {this, halfedge(v)};
+  }
   //! Neighbour vertices of v, counter-clockwise.
-  detail::LoopRange<detail::Step::ccw, detail::Yield::to_vertex> vertices(Vertex v) const { return {this, halfedge(v)}; }
-  detail::LoopRange<detail::Step::cw, detail::Yield::to_vertex> vertices_cw(Vertex v) const { return {this, halfedge(v)}; }
+  detail::LoopRange<detail::Step::ccw, detail::Yield::to_vertex> vertices(Vertex v) const {
+    return {this, halfedge(v)};
+  }
+  detail::LoopRange<detail::Step::cw, detail::Yield::to_vertex> vertices_cw(Vertex v) const {
+    return {this, halfedge(v)};
+  }
   //! Faces around v, counter-clockwise; holes are skipped.
   detail::LoopRange<detail::Step::ccw, detail::Yield::face> faces(Vertex v) const { return {this, halfedge(v)}; }
   detail::LoopRange<detail::Step::cw, detail::Yield::face> faces_cw(Vertex v) const { return {this, halfedge(v)}; }
@@ -273,40 +257,68 @@ class Mesh {
   detail::LoopRange<detail::Step::cw, detail::Yield::edge> edges_cw(Vertex v) const { return {this, halfedge(v)}; }
   //! Half-edges of f in order, starting at corner 0.
   detail::LoopRange<detail::Step::next, detail::Yield::halfedge> halfedges(Face f) const { return {this, halfedge(f)}; }
-  detail::LoopRange<detail::Step::prev, detail::Yield::halfedge> halfedges_reversed(Face f) const { return {this, halfedge(f)}; }
+  detail::LoopRange<detail::Step::prev, detail::Yield::halfedge> halfedges_reversed(Face f) const {
+    return {this, halfedge(f)};
+  }
   //! Corner vertices of f in order.
   detail::LoopRange<detail::Step::next, detail::Yield::to_vertex> vertices(Face f) const { return {this, halfedge(f)}; }
   detail::LoopRange<detail::Step::next, detail::Yield::edge> edges(Face f) const { return {this, halfedge(f)}; }
   //! Faces sharing an edge with f; boundary edges are skipped.
-  detail::LoopRange<detail::Step::next, detail::Yield::opposite_face> faces(Face f) const { return {this, halfedge(f)}; }
+  detail::LoopRange<detail::Step::next, detail::Yield::opposite_face> faces(Face f) const {
+    return {this, halfedge(f)};
+  }
   //! Half-edges of the loop through h (a face or a hole).
   detail::LoopRange<detail::Step::next, detail::Yield::halfedge> loop(Halfedge h) const { return {this, h}; }
 
   // ---- properties ----------------------------------------------------------------------
   template <class T>
-  VertexProperty<T> add_vertex_property(const std::string& name, T def = T()) { return VertexProperty<T>(vprops_.add<T>(name, def)); }
+  VertexProperty<T> add_vertex_property(const std::string& name, T def = T()) {
+    return VertexProperty<T>(vprops_.add<T>(name, def));
+  }
   template <class T>
-  VertexProperty<T> get_vertex_property(const std::string& name) const { return VertexProperty<T>(vprops_.get<T>(name)); }
+  VertexProperty<T> get_vertex_property(const std::string& name) const {
+    return VertexProperty<T>(vprops_.get<T>(name));
+  }
   template <class T>
-  VertexProperty<T> vertex_property(const std::string& name, T def = T()) { return get_or_add<Vertex, T>(vprops_, name, def); }
+  VertexProperty<T> vertex_property(const std::string& name, T def = T()) {
+    return get_or_add<Vertex, T>(vprops_, name, def);
+  }
   template <class T>
-  HalfedgeProperty<T> add_halfedge_property(const std::string& name, T def = T()) { return HalfedgeProperty<T>(hprops_.add<T>(name, def)); }
+  HalfedgeProperty<T> add_halfedge_property(const std::string& name, T def = T()) {
+    return HalfedgeProperty<T>(hprops_.add<T>(name, def));
+  }
   template <class T>
-  HalfedgeProperty<T> get_halfedge_property(const std::string& name) const { return HalfedgeProperty<T>(hprops_.get<T>(name)); }
+  HalfedgeProperty<T> get_halfedge_property(const std::string& name) const {
+    return HalfedgeProperty<T>(hprops_.get<T>(name));
+  }
   template <class T>
-  HalfedgeProperty<T> halfedge_property(const std::string& name, T def = T()) { return get_or_add<Halfedge, T>(hprops_, name, def); }
+  HalfedgeProperty<T> halfedge_property(const std::string& name, T def = T()) {
+    return get_or_add<Halfedge, T>(hprops_, name, def);
+  }
   template <class T>
-  EdgeProperty<T> add_edge_property(const std::string& name, T def = T()) { return EdgeProperty<T>(eprops_.add<T>(name, def)); }
+  EdgeProperty<T> add_edge_property(const std::string& name, T def = T()) {
+    return EdgeProperty<T>(eprops_.add<T>(name, def));
+  }
   template <class T>
-  EdgeProperty<T> get_edge_property(const std::string& name) const { return EdgeProperty<T>(eprops_.get<T>(name)); }
+  EdgeProperty<T> get_edge_property(const std::string& name) const {
+    return EdgeProperty<T>(eprops_.get<T>(name));
+  }
   template <class T>
-  EdgeProperty<T> edge_property(const std::string& name, T def = T()) { return get_or_add<Edge, T>(eprops_, name, def); }
+  EdgeProperty<T> edge_property(const std::string& name, T def = T()) {
+    return get_or_add<Edge, T>(eprops_, name, def);
+  }
   template <class T>
-  FaceProperty<T> add_face_property(const std::string& name, T def = T()) { return FaceProperty<T>(fprops_.add<T>(name, def)); }
+  FaceProperty<T> add_face_property(const std::string& name, T def = T()) {
+    return FaceProperty<T>(fprops_.add<T>(name, def));
+  }
   template <class T>
-  FaceProperty<T> get_face_property(const std::string& name) const { return FaceProperty<T>(fprops_.get<T>(name)); }
+  FaceProperty<T> get_face_property(const std::string& name) const {
+    return FaceProperty<T>(fprops_.get<T>(name));
+  }
   template <class T>
-  FaceProperty<T> face_property(const std::string& name, T def = T()) { return get_or_add<Face, T>(fprops_, name, def); }
+  FaceProperty<T> face_property(const std::string& name, T def = T()) {
+    return get_or_add<Face, T>(fprops_, name, def);
+  }
 
   //! The containers, for code that handles properties generically (builders, GC, IO).
   PropertyContainer& vertex_properties() { return vprops_; }

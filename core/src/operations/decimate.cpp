@@ -12,11 +12,11 @@
 #include <optional>
 #include <vector>
 
+#include "binding.h"
 #include "hedge/distance.h"
 #include "hedge/error.h"
-#include "hedge/limits.h"
 #include "hedge/geometry.h"
-#include "binding.h"
+#include "hedge/limits.h"
 #include "parallel.h"
 #include "welded_copies.h"
 #ifdef HEDGE_DECIMATE_DEBUG
@@ -185,9 +185,9 @@ class EdgeQueue {
       std::size_t live = 0;
       // The versions of a bucket's edges are scattered over the array: fetch them ahead.
       constexpr std::size_t kAhead = 64;
-      for (std::size_t j = 0; j < std::min(kAhead, from.size()); ++j) __builtin_prefetch(&(*versions_)[from[j].edge]);
+      for (std::size_t j = 0; j < std::min(kAhead, from.size()); ++j) detail::prefetch(&(*versions_)[from[j].edge]);
       for (std::size_t j = 0; j < from.size(); ++j) {
-        if (j + kAhead < from.size()) __builtin_prefetch(&(*versions_)[from[j + kAhead].edge]);
+        if (j + kAhead < from.size()) detail::prefetch(&(*versions_)[from[j + kAhead].edge]);
         if ((*versions_)[from[j].edge] == version(from[j].key)) from[live++] = from[j];
       }
       size_ -= from.size() - live;
@@ -287,7 +287,7 @@ class Decimator {
     ahead_edge_ = Edge(edge);
     ahead_stage_ = 1;
     m_.prefetch(Mesh::halfedge(ahead_edge_, 0));
-    __builtin_prefetch(&version_[edge]);
+    detail::prefetch(&version_[edge]);
   }
   void fetch_ahead();
   Edge ahead_edge_;
@@ -473,7 +473,8 @@ void Decimator::find_corner_channels() {
   PropertyContainer& hp = m_.halfedge_properties();
   for (std::size_t i = 0; i < hp.count(); ++i) {
     PropertyArray& a = hp.at(i);
-    if (a.type() == typeid(ChannelArray) && !a.is_internal()) corner_channels_.push_back(static_cast<ChannelArray*>(&a));
+    if (a.type() == typeid(ChannelArray) && !a.is_internal())
+      corner_channels_.push_back(static_cast<ChannelArray*>(&a));
   }
   seam_mode_ = opt_.preserve_uv_seams && !corner_channels_.empty();
 
@@ -658,7 +659,7 @@ void Decimator::fetch_ahead() {
     for (int i = 0; i < 2; ++i) {
       const Halfedge x = i == 0 ? h0 : o0;
       const Vertex v = m_.to_vertex(x);
-      __builtin_prefetch(&vd_[v.idx()]);
+      detail::prefetch(&vd_[v.idx()]);
       m_.prefetch(v);
       if (const Face f = m_.face(x); f.is_valid()) m_.prefetch(f), m_.prefetch(m_.next(x)), m_.prefetch(m_.prev(x));
       ahead_ring_[i] = ahead_ring_start_[i] = x;
@@ -666,7 +667,7 @@ void Decimator::fetch_ahead() {
   } else if (ahead_stage_ == 2) {
     // The opposite corners, from the half-edges stage 1 fetched.
     for (Halfedge x : {h0, o0})
-      if (m_.face(x).is_valid()) __builtin_prefetch(&vd_[m_.to_vertex(m_.next(x)).idx()]);
+      if (m_.face(x).is_valid()) detail::prefetch(&vd_[m_.to_vertex(m_.next(x)).idx()]);
   }
   // One step around both rings: the neighbour's data, and the next half-edge's record.
   bool more = false;
@@ -674,9 +675,9 @@ void Decimator::fetch_ahead() {
     Halfedge& x = ahead_ring_[i];
     if (!x.is_valid()) continue;
     const Vertex w = m_.to_vertex(x);
-    __builtin_prefetch(&m_.position(w));
-    __builtin_prefetch(&vd_[w.idx()]);
-    __builtin_prefetch(&version_[Mesh::edge(x).idx()]);
+    detail::prefetch(&m_.position(w));
+    detail::prefetch(&vd_[w.idx()]);
+    detail::prefetch(&version_[Mesh::edge(x).idx()]);
     x = m_.ccw_rotated(x);
     if (x == ahead_ring_start_[i]) {
       x = Halfedge();
@@ -701,7 +702,7 @@ void Decimator::fill_heap() {
     for (std::size_t i = begin; i < end; ++i) {
       if (i + kAhead < end)
         for (unsigned side = 0; side < 2; ++side)
-          __builtin_prefetch(&vd_[m_.vertex(Edge(static_cast<Index>(i + kAhead)), side).idx()]);
+          detail::prefetch(&vd_[m_.vertex(Edge(static_cast<Index>(i + kAhead)), side).idx()]);
       const Edge e(static_cast<Index>(i));
       Candidate c;
       keys[i] = !m_.is_deleted(e) && evaluate(e, c) ? EdgeQueue::key(c.cost, 0) : kNone;
@@ -775,7 +776,7 @@ Decimator::Refusal Decimator::check(Halfedge h, const Point& target) const {
     const Vertex w = m_.to_vertex(x);
     // The fold test below reads every neighbour's position: start those cache misses now,
     // so they overlap the link test instead of following it one by one.
-    __builtin_prefetch(&m_.position(w));
+    detail::prefetch(&m_.position(w));
     ring.push_back({w, m_.face(x), Vec3d{}});
     x = m_.ccw_rotated(x);
     more = x != start;
@@ -1074,7 +1075,7 @@ void Decimator::collapse(Halfedge h, const Candidate& c) {
   // Every edge at the kept vertex changed: evaluate them now, while their half-edges are in
   // cache (one sweep to fetch the neighbours' data, one to evaluate), rather than when they
   // surface cold.
-  for (Halfedge x : m_.outgoing(v1)) __builtin_prefetch(&vd_[m_.to_vertex(x).idx()]);
+  for (Halfedge x : m_.outgoing(v1)) detail::prefetch(&vd_[m_.to_vertex(x).idx()]);
   for (Halfedge x : m_.outgoing(v1)) {
     requeue(Mesh::edge(x));
     fetch_ahead();

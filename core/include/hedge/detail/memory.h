@@ -1,0 +1,44 @@
+// Memory helpers of the mesh's arrays. Not part of hedge's interface: mesh.h needs them in
+// its member types and inline functions, nothing outside the core should use them.
+#pragma once
+
+#include <memory>
+#include <type_traits>
+#include <utility>
+
+namespace hedge::detail {
+
+//! std::allocator, except that an element made without a value (resize(n), emplace_back())
+//! is left unset. The mesh's connectivity arrays use it so that a builder that writes every
+//! field itself (Mesh::resize_unset) does not pay for a fill first: on a big mesh that fill
+//! is one thread taking every page fault of tens of megabytes, which the builder's own
+//! writes, spread over its threads, take anyway.
+template <class T>
+struct UnsetAllocator : std::allocator<T> {
+  static_assert(std::is_trivially_copyable_v<T> && std::is_trivially_destructible_v<T>);
+  using value_type = T;
+  UnsetAllocator() = default;
+  template <class U>
+  UnsetAllocator(const UnsetAllocator<U>&) noexcept {}
+  template <class U>
+  struct rebind {
+    using other = UnsetAllocator<U>;
+  };
+  template <class U>
+  void construct(U*) noexcept {}
+  template <class U, class... Args>
+  void construct(U* p, Args&&... args) {
+    std::construct_at(p, std::forward<Args>(args)...);
+  }
+};
+
+//! Starts loading the cache line at p (a hint; changes nothing, a no-op where unsupported).
+inline void prefetch(const void* p) {
+#if defined(__GNUC__) || defined(__clang__)
+  __builtin_prefetch(p);
+#else
+  (void)p;
+#endif
+}
+
+}  // namespace hedge::detail
