@@ -16,20 +16,28 @@ namespace hedge {
 
 const char* param_type_name(ParamType type) {
   switch (type) {
-    case ParamType::boolean: return "bool";
-    case ParamType::integer: return "int";
-    case ParamType::real: return "float";
-    case ParamType::choice: return "enum";
+    case ParamType::boolean:
+      return "bool";
+    case ParamType::integer:
+      return "int";
+    case ParamType::real:
+      return "float";
+    case ParamType::choice:
+      return "enum";
   }
   return "unknown";
 }
 
 const char* category_name(Category category) {
   switch (category) {
-    case Category::measure: return "Measure";
-    case Category::cleaning: return "Cleaning";
-    case Category::remeshing: return "Remeshing";
-    case Category::smoothing: return "Smoothing";
+    case Category::measure:
+      return "Measure";
+    case Category::cleaning:
+      return "Cleaning";
+    case Category::remeshing:
+      return "Remeshing";
+    case Category::smoothing:
+      return "Smoothing";
   }
   return "Other";
 }
@@ -54,7 +62,8 @@ std::string ParamSpec::range_text() const {
   const bool integral = type == ParamType::integer;
   auto bound = [&](double x) { return integral ? std::to_string(static_cast<std::int64_t>(x)) : number_text(x); };
   switch (type) {
-    case ParamType::boolean: return "true or false";
+    case ParamType::boolean:
+      return "true or false";
     case ParamType::integer:
     case ParamType::real: {
       const std::string what = integral ? "an integer " : "a number ";
@@ -74,10 +83,14 @@ std::string value_text(const Value& value) {
   return std::visit(
       [](const auto& v) -> std::string {
         using T = std::decay_t<decltype(v)>;
-        if constexpr (std::is_same_v<T, bool>) return v ? "true" : "false";
-        else if constexpr (std::is_same_v<T, std::int64_t>) return std::to_string(v);
-        else if constexpr (std::is_same_v<T, double>) return number_text(v);
-        else return v;
+        if constexpr (std::is_same_v<T, bool>)
+          return v ? "true" : "false";
+        else if constexpr (std::is_same_v<T, std::int64_t>)
+          return std::to_string(v);
+        else if constexpr (std::is_same_v<T, double>)
+          return number_text(v);
+        else
+          return v;
       },
       value);
 }
@@ -109,10 +122,18 @@ std::string json_string(const std::string& s) {
   std::string out = "\"";
   for (char c : s) {
     switch (c) {
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      case '\n': out += "\\n"; break;
-      case '\t': out += "\\t"; break;
+      case '"':
+        out += "\\\"";
+        break;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      case '\t':
+        out += "\\t";
+        break;
       default:
         if (static_cast<unsigned char>(c) < 0x20) {
           char buffer[8];
@@ -153,31 +174,34 @@ const std::vector<Operation>& catalogue() {
   return operations;
 }
 
-namespace {
 std::string json_list(const std::vector<std::string>& items) {
   std::string out = "[";
   for (std::size_t i = 0; i < items.size(); ++i) out += (i ? ", " : "") + json_string(items[i]);
   return out + "]";
 }
 
-std::string param_json(const ParamSpec& p) {
+JsonObject param_json(const ParamSpec& p) {
   JsonObject out;
-  out.add("id", p.id).add("label", p.label).add("type", param_type_name(p.type)).raw("default", json_value(p.default_value));
+  out.add("id", p.id)
+      .add("label", p.label)
+      .add("type", param_type_name(p.type))
+      .raw("default", json_value(p.default_value));
   if (p.type == ParamType::integer) {
     out.add("min", static_cast<std::int64_t>(p.range.min));
     out.raw("max", p.range.max ? json_value(static_cast<std::int64_t>(*p.range.max)) : "null");
   }
-  if (p.type == ParamType::real) out.add("min", p.range.min).raw("max", p.range.max ? json_value(*p.range.max) : "null");
-  return out.raw("choices", json_list(p.choices)).add("range_text", p.range_text()).add("help", p.help).str();
+  if (p.type == ParamType::real)
+    out.add("min", p.range.min).raw("max", p.range.max ? json_value(*p.range.max) : "null");
+  return out.raw("choices", json_list(p.choices)).add("range_text", p.range_text()).add("help", p.help);
 }
-}  // namespace
 
 std::string catalogue_json() {
   std::string out = "{\"operations\": [";
   bool first_op = true;
   for (const Operation& op : catalogue()) {
     std::string params = "[";
-    for (std::size_t i = 0; i < op.params.size(); ++i) params += (i ? ",\n  " : "\n  ") + param_json(op.params[i]);
+    for (std::size_t i = 0; i < op.params.size(); ++i)
+      params += (i ? ",\n  " : "\n  ") + param_json(op.params[i]).str();
     JsonObject entry;
     entry.add("id", op.id).add("title", op.title).add("category", category_name(op.category));
     entry.add("changes_mesh", op.changes_mesh).add("help", op.help).raw("params", params + "]");
@@ -211,18 +235,24 @@ Value check_value(const Operation& op, const ParamSpec& p, const Value& value) {
       refuse(op, p, text);
     case ParamType::integer: {
       std::int64_t i = 0;
-      if (const auto* pi = std::get_if<std::int64_t>(&value)) i = *pi;
-      else if (const auto* pd = std::get_if<double>(&value); pd && std::isfinite(*pd) && std::floor(*pd) == *pd && std::fabs(*pd) < 9e15)
+      if (const auto* pi = std::get_if<std::int64_t>(&value))
+        i = *pi;
+      else if (const auto* pd = std::get_if<double>(&value);
+               pd && std::isfinite(*pd) && std::floor(*pd) == *pd && std::fabs(*pd) < 9e15)
         i = static_cast<std::int64_t>(*pd);
-      else refuse(op, p, text);
+      else
+        refuse(op, p, text);
       if (!p.range.contains(double(i))) refuse(op, p, text);
       return i;
     }
     case ParamType::real: {
       double d = 0;
-      if (const auto* pd = std::get_if<double>(&value)) d = *pd;
-      else if (const auto* pi = std::get_if<std::int64_t>(&value)) d = double(*pi);
-      else refuse(op, p, text);
+      if (const auto* pd = std::get_if<double>(&value))
+        d = *pd;
+      else if (const auto* pi = std::get_if<std::int64_t>(&value))
+        d = double(*pi);
+      else
+        refuse(op, p, text);
       if (!std::isfinite(d) || !p.range.contains(d)) refuse(op, p, text);
       return d;
     }
@@ -256,7 +286,8 @@ Value parse_text(const Operation& op, const ParamSpec& p, const std::string& tex
       if (ec != std::errc() || end != text.data() + text.size()) refuse(op, p, text);
       return d;
     }
-    case ParamType::choice: return text;
+    case ParamType::choice:
+      return text;
   }
   refuse(op, p, text);
 }
@@ -267,7 +298,8 @@ ParamValues resolve(const Operation& op, const Given& given, Convert convert) {
     if (!op.find_param(id)) {
       std::string known;
       for (const auto& p : op.params) known += (known.empty() ? "" : ", ") + p.id;
-      throw Error(op.id + ": unknown parameter '" + id + "'" + (known.empty() ? "; it takes none" : "; its parameters are: " + known));
+      throw Error(op.id + ": unknown parameter '" + id + "'" +
+                  (known.empty() ? "; it takes none" : "; its parameters are: " + known));
     }
   ParamValues values;
   for (const auto& p : op.params) {

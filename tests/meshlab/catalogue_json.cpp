@@ -15,14 +15,9 @@ int main() {
     std::string params = "[";
     for (std::size_t i = 0; i < op.params.size(); ++i) {
       const ParamSpec& p = op.params[i];
-      std::string choices = "[";
-      for (std::size_t k = 0; k < p.choices.size(); ++k) choices += (k ? ", " : "") + json_string(p.choices[k]);
-      JsonObject param;
-      param.add("id", p.id).add("label", p.label).add("type", param_type_name(p.type));
-      param.add("rich_type", meshlab::rich_type_name(meshlab::rich_kind(p)))
-          .raw("default", json_value(p.default_value));
-      param.add("min", p.range.min).raw("max", p.range.max ? json_value(*p.range.max) : "null");
-      params += (i ? ",\n    " : "\n    ") + param.raw("choices", choices + "]").str();
+      JsonObject param = param_json(p);
+      param.add("rich_type", meshlab::rich_type_name(meshlab::rich_kind(p)));
+      params += (i ? ",\n    " : "\n    ") + param.str();
     }
     JsonObject entry;
     entry.add("id", op.id).add("title", op.title).add("filter", meshlab::filter_name(op).toStdString());

@@ -51,8 +51,8 @@ struct ParamSpec {
   std::string label;  //!< short name for UIs, e.g. "Target ratio"
   std::string help;
   ParamType type = ParamType::real;
-  Value default_value;  //!< of the parameter's type; a choice's default is its name
-  Range range;          //!< integer and real
+  Value default_value;               //!< of the parameter's type; a choice's default is its name
+  Range range;                       //!< integer and real
   std::vector<std::string> choices;  //!< for choice
 
   //! The default's index in choices (choice parameters).
@@ -73,11 +73,13 @@ class JsonObject {
  public:
   JsonObject& add(const std::string& key, const Value& value) { return raw(key, json_value(value)); }
   template <class T>
-    requires std::is_arithmetic_v<T>
-  JsonObject& add(const std::string& key, T x) {
-    if constexpr (std::is_same_v<T, bool>) return add(key, Value(x));
-    else if constexpr (std::is_integral_v<T>) return add(key, Value(static_cast<std::int64_t>(x)));
-    else return add(key, Value(static_cast<double>(x)));
+  requires std::is_arithmetic_v<T> JsonObject& add(const std::string& key, T x) {
+    if constexpr (std::is_same_v<T, bool>)
+      return add(key, Value(x));
+    else if constexpr (std::is_integral_v<T>)
+      return add(key, Value(static_cast<std::int64_t>(x)));
+    else
+      return add(key, Value(static_cast<double>(x)));
   }
   JsonObject& add(const std::string& key, const char* s) { return add(key, Value(std::string(s))); }
   //! A value already in JSON (a nested object or array).
@@ -90,6 +92,11 @@ class JsonObject {
  private:
   std::string text_ = "{";
 };
+
+//! JSON of a list of strings, and of a parameter (id, label, type, default, min and max for
+//! numbers, max null when unbounded, choices, range_text, help).
+std::string json_list(const std::vector<std::string>& items);
+JsonObject param_json(const ParamSpec& p);
 
 //! Checked parameter values of one run: every parameter of the operation is present.
 class ParamValues {
@@ -119,10 +126,10 @@ struct OperationReport {
 };
 
 struct Operation {
-  std::string id;        //!< snake_case: "decimate"
-  std::string title;     //!< "Decimate": MeshLab shows "Hedge: Decimate"
+  std::string id;     //!< snake_case: "decimate"
+  std::string title;  //!< "Decimate": MeshLab shows "Hedge: Decimate"
   Category category = Category::measure;
-  std::string help;      //!< what it does, when to use it, the paper it follows
+  std::string help;  //!< what it does, when to use it, the paper it follows
   std::vector<ParamSpec> params;
   //! The report's keys, in order (some appear only when they apply).
   std::vector<std::string> results;
@@ -149,8 +156,8 @@ ParamValues resolve_params(const Operation& op, const std::map<std::string, std:
 ParamValues resolve_params(const Operation& op, const std::map<std::string, Value>& given);
 
 struct RunResult {
-  Soup soup;              //!< the result; empty for report-only operations (changes_mesh false)
-  OperationReport report; //!< the operation's report, after the build report's entries
+  Soup soup;               //!< the result; empty for report-only operations (changes_mesh false)
+  OperationReport report;  //!< the operation's report, after the build report's entries
   BuildReport build;
 };
 
