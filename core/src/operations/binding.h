@@ -8,10 +8,12 @@
 //       .result(&DecimateReport::faces_after, "faces_after");
 #pragma once
 
+#include <algorithm>
 #include <concepts>
 #include <functional>
 #include <memory>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <type_traits>
 #include <utility>
@@ -86,6 +88,9 @@ class Binding {
                   std::string help) {
     std::vector<std::string> choices;
     for (E value : values) choices.push_back(name(value));
+    // A default users could not pick back would make the front ends disagree with the core.
+    if (std::find(values.begin(), values.end(), Options{}.*field) == values.end())
+      throw std::logic_error(op_.id + ": the default of " + id + " is not among its choices");
     add_param(ParamType::choice, std::move(id), std::move(label), std::move(help), {},
               std::string(name(Options{}.*field)));
     op_.params.back().choices = std::move(choices);
