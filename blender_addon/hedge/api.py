@@ -132,41 +132,79 @@ def targets(context):
     return out
 
 
+# How many of an operation's results (catalogue order) the one-line summary shows.
+SUMMARY_RESULTS = 4
+
+
 def summary(op, report):
-    """One line for the info area."""
+    """One line for the info area: the operation's first results and the time."""
+    keys = [k for k in op["results"] if k in report][:SUMMARY_RESULTS] + ["seconds"]
     parts = []
-    for key in ("faces_before", "faces_after", "faces", "vertices", "holes", "boundary_loops", "seconds"):
+    for key in keys:
         if key in report:
             value = report[key]
             parts.append(f"{key.replace('_', ' ')} {value:.3g}" if isinstance(value, float) else f"{key.replace('_', ' ')} {value}")
     return f"Hedge {op['title']}: " + (", ".join(parts) if parts else "done")
 
 
+class Batch:
+    """One run of an operation over several meshes, the one path of the batch API and of the
+    operators (synchronous or on a worker thread): each mesh is read and run in turn, and
+    nothing is written unless every run succeeded and every result can be written."""
+
+    def __init__(self, op_id, target_list, params):
+        self.op = operation(op_id)
+        self.targets = target_list
+        self.params = dict(params)
+        self.index = 0
+        last_params[op_id] = dict(params)
+
+    def finished(self):
+        return self.index >= len(self.targets)
+
+    def read_next(self):
+        """The soup of the next mesh to run."""
+        return self.targets[self.index].read(self.op)
+
+    def record(self, result, report):
+        """Keeps the next mesh's result (from native.run or a Job)."""
+        t = self.targets[self.index]
+        t.result, t.report = result, report
+        report["object"] = t.obj.name
+        self.index += 1
+
+    def commit(self):
+        """Checks every result, then writes them all; returns the reports."""
+        for t in self.targets:
+            t.check_writable(self.op)
+        for t in self.targets:
+            t.write()
+            remember(self.op, t.obj, t.report)
+        return [t.report for t in self.targets]
+
+    def release(self):
+        for t in self.targets:
+            t.release()
+
+
 def run_targets(op_id, target_list, params, progress=None):
-    """Runs one operation on several targets; writes nothing unless every one succeeded."""
-    op = operation(op_id)
+    """Runs one operation on several targets, synchronously; writes nothing unless every one
+    succeeded."""
+    batch = Batch(op_id, target_list, params)
     native_module = require_native()
-    last_params[op_id] = dict(params)
     n = len(target_list)
     try:
-        for i, t in enumerate(target_list):
-            soup = t.read(op)
+        while not batch.finished():
             step = None
             if progress is not None:
-                def step(fraction, stage, i=i):
+                def step(fraction, stage, i=batch.index):
                     return progress((i + fraction) / n, stage)
-            t.result, t.report = native_module.run(op_id, soup, dict(params), step)
-            t.report["object"] = t.obj.name
-        for t in target_list:
-            t.check_writable(op)
+            soup = batch.read_next()
+            batch.record(*native_module.run(op_id, soup, batch.params, step))
+        return batch.commit()
     except BaseException:
-        for t in target_list:
-            t.release()
+        batch.release()
         raise
-    for t in target_list:
-        t.write()
-        remember(op, t.obj, t.report)
-    return [t.report for t in target_list]
 
 
 def remember(op, obj, report):

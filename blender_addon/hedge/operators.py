@@ -109,8 +109,8 @@ class HedgeOperator:
     def invoke(self, context, event):
         if bpy.app.background or context.window is None:
             return self.execute(context)
-        self._targets = [api.Target(obj) for obj in api.targets(context)]
-        self._index = -1
+        self._batch = api.Batch(self.operation["id"], [api.Target(obj) for obj in api.targets(context)],
+                                self.params())
         self._job = None
         try:
             self._next()
@@ -125,14 +125,11 @@ class HedgeOperator:
         return {'RUNNING_MODAL'}
 
     def _next(self):
-        self._index += 1
-        if self._index < len(self._targets):
-            t = self._targets[self._index]
-            self._job = require_native().Job(self.operation["id"], t.read(self.operation), self.params())
+        if not self._batch.finished():
+            self._job = require_native().Job(self.operation["id"], self._batch.read_next(), self._batch.params)
 
     def _release(self):
-        for t in self._targets:
-            t.release()
+        self._batch.release()
         self._job = None
 
     def _stop(self, context):
@@ -153,32 +150,30 @@ class HedgeOperator:
             return self.fail(Cancelled("cancelled by the user"))
         if event.type != 'TIMER':
             return {'RUNNING_MODAL'}
-        n = len(self._targets)
+        n = len(self._batch.targets)
         fraction, stage = self._job.progress()
-        context.window_manager.progress_update(int((self._index + fraction) / n * 1000))
+        context.window_manager.progress_update(int((self._batch.index + fraction) / n * 1000))
         if context.workspace:
             context.workspace.status_text_set(f"Hedge {self.operation['title']}: {stage} "
                                               f"({100 * fraction:.0f} %) - Esc to cancel")
         if not self._job.done():
             return {'RUNNING_MODAL'}
         try:
-            t = self._targets[self._index]
-            t.result, t.report = self._job.result()
-            t.report["object"] = t.obj.name
+            self._batch.record(*self._job.result())
             self._next()
-            if self._index < n:
-                return {'RUNNING_MODAL'}
-            for t in self._targets:
-                t.check_writable(self.operation)
         except Error as e:
             self._stop(context)
             self._release()
             return self.fail(e)
+        if not self._batch.finished():
+            return {'RUNNING_MODAL'}
         self._stop(context)
-        for t in self._targets:
-            t.write()
-            api.remember(self.operation, t.obj, t.report)
-        return self.done(context, [t.report for t in self._targets])
+        try:
+            reports = self._batch.commit()
+        except Error as e:
+            self._release()
+            return self.fail(e)
+        return self.done(context, reports)
 
 
 def make_operator(op):
