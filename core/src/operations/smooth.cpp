@@ -231,7 +231,8 @@ Operation smooth_operation() {
       "repeated. Methods: uniform (the umbrella operator: simple and fast, but the shape shrinks and triangles "
       "slide along the surface), cotangent (Desbrun et al. 1999: cotangent weights, clamped and normalized, so "
       "vertices move across the surface rather than along it), taubin (Taubin 1995: a shrinking λ step followed "
-      "by an inflating μ step, μ = -λ / (1 - 0.1 λ); smooths noise while keeping the volume; strengths above "
+      "by an inflating μ step, μ = -λ / (1 - k_PB λ) with k_PB the pass band (0.1 by default); smooths noise while "
+      "keeping the volume; strengths above "
       "0.68 are limited to keep it stable). Strength is λ, the fraction of the way to the mean per step. With "
       "preserve_boundary, boundary vertices stay fixed; otherwise they are smoothed along their boundary curve. "
       "Only positions change: the connectivity and every attribute are kept, except vertex and face normals, which "
@@ -253,6 +254,8 @@ Operation smooth_operation() {
               "λ: how far each step moves a vertex toward the mean (0 to 1)")
       .option(&O::preserve_boundary, "preserve_boundary", "Preserve boundary",
               "keep boundary vertices fixed (otherwise smooth them along the boundary)")
+      .option(&O::pass_band, "pass_band", "Pass band", between(0.01, 0.5),
+              "taubin only: k_PB, the frequency below which shapes pass unchanged (μ = -λ / (1 - k_PB λ))")
       .result("method",
               [](const O& o, const R&) -> std::optional<Value> { return std::string(smoothing_method_name(o.method)); })
       .result(&R::iterations, "iterations")
