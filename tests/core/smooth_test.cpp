@@ -364,6 +364,22 @@ TEST(Smooth, CatalogueEntry) {
   ASSERT_NE(r.find("mu"), nullptr);
 }
 
+TEST(Smooth, CataloguePassBandReachesTaubin) {
+  const Operation& op = find_operation("smooth");
+  EXPECT_EQ(op.find_param("pass_band")->default_value, Value(0.1));
+  EXPECT_EQ(op.find_param("pass_band")->range.max, 0.5);
+  Mesh mesh = sphere(2);
+  add_radial_noise(mesh, 0.05f);
+  OperationReport r = op.run(
+      mesh,
+      resolve_params(
+          op, std::map<std::string, std::string>{{"method", "taubin"}, {"strength", "0.5"}, {"pass_band", "0.2"}}),
+      Progress::none());
+  ASSERT_NE(r.find("mu"), nullptr);
+  EXPECT_NEAR(std::get<double>(*r.find("mu")), -0.5 / (1 - 0.2 * 0.5), 1e-12);
+  EXPECT_THROW(resolve_params(op, std::map<std::string, std::string>{{"pass_band", "0.9"}}), Error);
+}
+
 TEST(Smooth, DragonTimings) {
   const std::string path = std::string(HEDGE_MESH_DIR) + "/dragon.ply";
   if (!std::filesystem::exists(path)) GTEST_SKIP() << "dragon.ply not found";
