@@ -38,6 +38,10 @@ struct DecimateOptions {
   //! Refuse collapses that create a triangle of quality (2 r_in / r_out) below this, unless
   //! the triangles they replace were already worse.
   double min_quality = 0;
+  //! Only the selected faces (the "selected" face channel a host's selection fills) change:
+  //! vertices with a face outside the selection neither move nor go, and target_ratio applies
+  //! to the selected faces (target_faces stays a count of all faces).
+  bool selection_only = false;
   //! Threads for measuring every edge before the first collapse (the collapses themselves
   //! are sequential); the result is the same for any count. 0: hedge::thread_count().
   unsigned threads = 0;

@@ -19,6 +19,9 @@ struct DelaunayOptions {
   double angle_epsilon = 1e-6;
   //! Flips allowed per edge of the mesh before giving up (curved surfaces may not converge).
   double flip_budget_per_edge = 50;
+  //! Only edges between two selected faces (the "selected" face channel a host's selection
+  //! fills) are flipped.
+  bool selection_only = false;
   //! Keep a copy of the mesh while working, so that a cancelled or failed run leaves it as
   //! it was. run_operation() turns it off: its mesh is built for the run and dropped on failure.
   bool keep_input_on_failure = true;
@@ -33,8 +36,9 @@ struct DelaunayCensus {
   //! of those: is_flip_ok refuses (the other diagonal exists, valence 3), or the weld of
   //! build()'s copies would meet the flip (a split non-manifold edge, a new edge already there)
   std::size_t blocked = 0;
-  std::size_t folds = 0;         //!< of those: the flipped edge would be a feature or turn a triangle over
-  std::size_t flippable = 0;     //!< of those: none of the above (0 unless the budget ran out)
+  std::size_t folds = 0;       //!< of those: the flipped edge would be a feature or turn a triangle over
+  std::size_t unselected = 0;  //!< of those: with selection_only, not between two selected faces
+  std::size_t flippable = 0;   //!< of those: none of the above (0 unless the budget ran out)
 };
 
 struct DelaunayReport {

@@ -27,7 +27,10 @@ struct SmoothOptions {
   //! curve (the mean of their two boundary neighbours), never across the hole.
   bool preserve_boundary = true;
   double pass_band = 0.1;  //!< Taubin's k_PB: μ = -λ / (1 - k_PB λ)
-  unsigned threads = 0;    //!< 0: hedge::thread_count()
+  //! Only selected vertices move (the "selected" vertex channel a host's selection fills; the
+  //! vertices inside the selected faces when there is only a face selection).
+  bool selection_only = false;
+  unsigned threads = 0;  //!< 0: hedge::thread_count()
 };
 
 struct SmoothReport {

@@ -25,6 +25,8 @@ const char* triangulation_method_name(TriangulationMethod method);
 struct TriangulateOptions {
   TriangulationMethod method = TriangulationMethod::min_area;
   std::size_t max_dp_corners = 100;  //!< min_area: larger polygons are ear-clipped
+  //! Only the selected polygons (the "selected" face channel a host's selection fills).
+  bool selection_only = false;
   //! Keep a copy of the mesh while working, so that a cancelled or failed run leaves it as
   //! it was. run_operation() turns it off: its mesh is built for the run and dropped on failure.
   bool keep_input_on_failure = true;
@@ -43,8 +45,8 @@ struct TriangulateReport {
   std::size_t centroid_vertices = 0;
 };
 
-//! Splits every face of more than 3 corners into triangles, by Mesh::insert_edge, so each
-//! diagonal keeps every invariant. A diagonal is never one that exists already as an edge
+//! Splits every face of more than 3 corners (every selected one, with selection_only) into triangles, by
+//! Mesh::insert_edge, so each diagonal keeps every invariant. A diagonal is never one that exists already as an edge
 //! elsewhere (the mesh stays manifold). In the polygon's plane (Newell's normal) every triangle
 //! is counter-clockwise, so the triangles cover exactly the polygon and none is flipped.
 //!

@@ -22,6 +22,7 @@
 #include "hedge/catalogue.h"
 #include "hedge/error.h"
 #include "list.h"
+#include "selection.h"
 
 namespace hedge {
 
@@ -132,6 +133,15 @@ class Binding {
     return messages([field](const Options&, const Report& r) { return r.*field; });
   }
 
+  //! The selection_only option, with one id, label and message for every operation that has
+  //! it (selection.h): a run with it on and nothing selected says so. `help` says what the
+  //! selection limits in this operation.
+  Binding& selection(bool Options::*field, std::string help) {
+    option(field, "selection_only", "Selection only", std::move(help));
+    state_->selection = field;
+    return *this;
+  }
+
   //! For a report-only operation: the mesh is measured, not changed.
   Binding& measures_only() {
     op_.changes_mesh = false;
@@ -143,11 +153,13 @@ class Binding {
     op.run = [state = state_](Mesh& mesh, const ParamValues& values, Progress& progress) {
       Options options;
       for (const auto& set : state->setters) set(options, values);
+      const bool nothing_selected = state->selection && options.*(state->selection) && !detail::has_selection(mesh);
       const Report r = state->function(mesh, options, progress);
       OperationReport report;
       for (const auto& [id, get] : state->getters)
         if (std::optional<Value> value = get(options, r)) report.add(id, std::move(*value));
       if (state->messages) report.messages = state->messages(options, r);
+      if (nothing_selected) report.messages.push_back(detail::kNothingSelected);
       return report;
     };
     return op;
@@ -160,6 +172,7 @@ class Binding {
     std::vector<Setter> setters;
     std::vector<std::pair<std::string, Getter>> getters;
     std::function<std::vector<std::string>(const Options&, const Report&)> messages;
+    bool Options::*selection = nullptr;
   };
 
   void add_param(ParamType type, std::string id, std::string label, std::string help, Range range, Value fallback) {

@@ -18,6 +18,7 @@
 #include "hedge/geometry.h"
 #include "hedge/limits.h"
 #include "parallel.h"
+#include "selection.h"
 #include "welded_copies.h"
 #ifdef HEDGE_DECIMATE_DEBUG
 #include <cstdio>
@@ -219,7 +220,9 @@ struct Candidate {
 // vertex may do with respect to seams of per-corner attributes: kOnSeam when a seam edge
 // touches it, kSeamLine when it lies inside one seam (it may slide along it), kLockedSeam
 // for seam ends, junctions and seams meeting the boundary (it stays).
-enum VertexFlag : std::uint8_t { kBoundary = 1, kOnSeam = 2, kSeamLine = 4, kLockedSeam = 8 };
+// kLocked: with selection_only, a vertex with a face outside the selection; it neither moves
+// nor goes, so those faces stay as they were.
+enum VertexFlag : std::uint8_t { kBoundary = 1, kOnSeam = 2, kSeamLine = 4, kLockedSeam = 8, kLocked = 16 };
 constexpr std::uint8_t kSeamBits = kOnSeam | kSeamLine | kLockedSeam;
 
 // Boundary edges add a plane through the edge, perpendicular to its face, so moving a
@@ -337,6 +340,7 @@ class Decimator {
   double scale_ = 1, inv_scale_ = 1;
   double cos_max_normal_change_ = 0;
   bool seam_mode_ = false;
+  std::vector<std::uint8_t> inside_selection_;  // per vertex, with selection_only (selection.h)
   bool has_boundary_ = false;
 
   // Everything evaluate() reads about a vertex, in one cache line: its quadric (about its
@@ -392,8 +396,13 @@ class Decimator {
 
 void Decimator::triangulate_polygons() {
   std::vector<Face> polygons;
+  // With selection_only, polygons outside the selection stay: their vertices are all locked,
+  // so no collapse reaches them.
+  const std::vector<std::uint8_t> selected =
+      opt_.selection_only ? detail::selected_faces(m_) : std::vector<std::uint8_t>();
   for (Face f : m_.faces())
-    if (m_.next(m_.next(m_.next(m_.halfedge(f)))) != m_.halfedge(f)) polygons.push_back(f);
+    if (m_.next(m_.next(m_.next(m_.halfedge(f)))) != m_.halfedge(f) && (selected.empty() || selected[f.idx()]))
+      polygons.push_back(f);
   for (Face f : polygons) m_.triangulate(f);
   report_.triangulated_faces = polygons.size();
 }
@@ -519,6 +528,7 @@ void Decimator::classify_vertices() {
           static_cast<std::uint16_t>(std::min<std::size_t>(m_.valence(v), std::numeric_limits<std::uint16_t>::max()));
       std::uint8_t f = m_.is_boundary(v) ? kBoundary : 0;
       if (seam_mode_) f |= classify(v);
+      if (!inside_selection_.empty() && !inside_selection_[i]) f |= kLocked;
       vd_[i].flags = f;
     }
   });
@@ -577,13 +587,13 @@ bool Decimator::evaluate(Edge e, Candidate& c) const {
   }
   auto removable = [&](std::uint8_t f) {
     if (opt_.preserve_boundary && (f & kBoundary) && !boundary_edge) return false;
-    if (f & kLockedSeam) return false;
+    if (f & (kLockedSeam | kLocked)) return false;
     if (f & kSeamLine) return seam_both;
     return true;
   };
   auto movable = [&](std::uint8_t f) {
     if (opt_.preserve_boundary && (f & kBoundary)) return false;
-    if (f & kLockedSeam) return false;
+    if (f & (kLockedSeam | kLocked)) return false;
     if (f & kSeamLine) return seam_both;
     return true;
   };
@@ -1059,8 +1069,9 @@ void Decimator::collapse(Halfedge h, const Candidate& c) {
   if (vr.is_valid()) --vd_[vr.idx()].valence;
   faces_ -= removed_faces;
 
-  // The kept vertex is on the boundary when either end was; vl and vr keep their status.
-  d1.flags = (d0.flags | d1.flags) & kBoundary;
+  // The kept vertex is on the boundary when either end was, and stays locked when it was (the
+  // removed end never is); vl and vr keep their status.
+  d1.flags = (d0.flags | d1.flags) & (kBoundary | kLocked);
   if (seam_mode_) {
     d1.flags |= classify(v1);
     for (Vertex v : {vl, vr}) {
@@ -1090,10 +1101,18 @@ DecimateReport Decimator::run() {
   progress_.update(0, "preparing");
   triangulate_polygons();
   faces_ = m_.n_faces();
+  // The faces the ratio applies to: all, or the selected ones (the rest stay).
+  std::size_t reducible = faces_;
+  if (opt_.selection_only) {
+    const std::vector<std::uint8_t> selected = detail::selected_faces(m_);
+    reducible = 0;
+    for (Face f : m_.faces()) reducible += selected[f.idx()];
+    inside_selection_ = detail::inside_selection(m_, selected);
+  }
   if (opt_.target_faces > 0)
     target_ = opt_.target_faces;
   else
-    target_ = static_cast<std::size_t>(std::llround(opt_.target_ratio * double(faces_)));
+    target_ = faces_ - reducible + static_cast<std::size_t>(std::llround(opt_.target_ratio * double(reducible)));
   report_.target_faces = target_;
   if (faces_ <= target_ || faces_ == 0) {
     report_.faces_after = faces_;
@@ -1277,6 +1296,9 @@ Operation decimate_operation() {
       .option(&O::min_quality, "min_quality", "Min triangle quality", between(0, 1),
               "Refuse collapses that create triangles of quality (2 inradius / circumradius, 1 = "
               "equilateral) below this, unless the triangles they replace were already worse.")
+      .selection(&O::selection_only,
+                 "Only the selected faces are simplified, the target ratio applying to them; faces outside "
+                 "the selection stay as they are, and so does the border between the two.")
       .result(&R::faces_before, "faces_before")
       .result(&R::faces_after, "faces_after")
       .result(&R::vertices_before, "vertices_before")

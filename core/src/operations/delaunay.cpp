@@ -9,10 +9,11 @@
 #include <string>
 #include <vector>
 
+#include "binding.h"
 #include "hedge/error.h"
 #include "hedge/normals.h"
 #include "hedge/provenance.h"
-#include "binding.h"
+#include "selection.h"
 #include "welded_copies.h"
 
 namespace hedge {
@@ -79,11 +80,25 @@ struct Seams {
   }
 };
 
-enum class Verdict { delaunay, flip, feature, seam, blocked, fold };
+enum class Verdict { delaunay, flip, unselected, feature, seam, blocked, fold };
 
-Verdict judge(const Mesh& m, Edge e, const DelaunayOptions& o, const Seams& seams, const detail::WeldedCopies& copies) {
+//! What judge() reads besides the mesh and the options, made once per pass.
+struct Context {
+  Seams seams;
+  detail::WeldedCopies copies;
+  std::vector<std::uint8_t> selected;  //!< per face, with selection_only; empty otherwise
+
+  Context(const Mesh& m, const DelaunayOptions& o)
+      : seams(m), copies(m), selected(o.selection_only ? detail::selected_faces(m) : std::vector<std::uint8_t>()) {}
+};
+
+Verdict judge(const Mesh& m, Edge e, const DelaunayOptions& o, const Context& context) {
   const Quad q = quad_of(m, e);
   if (angle_at(q.c, q.u, q.w) + angle_at(q.d, q.u, q.w) <= std::numbers::pi + o.angle_epsilon) return Verdict::delaunay;
+  const std::vector<std::uint8_t>& selected = context.selected;
+  if (!selected.empty() && !(selected[m.face(q.h0).idx()] && selected[m.face(q.h1).idx()])) return Verdict::unselected;
+  const Seams& seams = context.seams;
+  const detail::WeldedCopies& copies = context.copies;
   const Vec3d n0 = normal(q.u, q.w, q.c), n1 = normal(q.w, q.u, q.d);
   if (degrees_between(n0, n1) > o.feature_angle) return Verdict::feature;
   if (seams.at(m, q)) return Verdict::seam;
@@ -117,12 +132,11 @@ double dihedral_angle_degrees(const Mesh& mesh, Edge e) {
 
 DelaunayCensus delaunay_census(const Mesh& mesh, const DelaunayOptions& options) {
   DelaunayCensus c;
-  const Seams seams(mesh);
-  const detail::WeldedCopies copies(mesh);
+  const Context context(mesh, options);
   for (Edge e : mesh.edges()) {
     if (!is_interior_triangle_edge(mesh, e)) continue;
     ++c.interior_edges;
-    const Verdict v = judge(mesh, e, options, seams, copies);
+    const Verdict v = judge(mesh, e, options, context);
     if (v == Verdict::delaunay) continue;
     ++c.non_delaunay;
     switch (v) {
@@ -137,6 +151,9 @@ DelaunayCensus delaunay_census(const Mesh& mesh, const DelaunayOptions& options)
         break;
       case Verdict::fold:
         ++c.folds;
+        break;
+      case Verdict::unselected:
+        ++c.unselected;
         break;
       default:
         ++c.flippable;
@@ -161,8 +178,7 @@ DelaunayReport make_delaunay(Mesh& mesh, const DelaunayOptions& options, Progres
   std::optional<Mesh> copy;
   Mesh& work = options.keep_input_on_failure ? copy.emplace(mesh) : mesh;
   report.before = delaunay_census(work, options);
-  const Seams seams(work);
-  const detail::WeldedCopies copies(work);
+  const Context context(work, options);
 
   std::vector<Index> stack;
   std::vector<char> queued(work.edges_size(), 0);
@@ -179,7 +195,7 @@ DelaunayReport make_delaunay(Mesh& mesh, const DelaunayOptions& options, Progres
     queued[e.idx()] = 0;
     if ((++pops & 0xffff) == 0)
       progress.update(0.05 + 0.9 * double(pops) / double(pops + stack.size()), "flipping edges");
-    if (judge(work, e, options, seams, copies) != Verdict::flip) continue;
+    if (judge(work, e, options, context) != Verdict::flip) continue;
     if (double(report.flips) >= budget) {
       report.budget_exhausted = true;
       break;
@@ -227,6 +243,7 @@ Operation make_delaunay_operation() {
       .option(&O::feature_angle, "feature_angle", "Feature angle", between(0, 180),
               "edges whose faces meet at a dihedral angle above this (degrees) are features and are never "
               "flipped")
+      .selection(&O::selection_only, "only edges between two selected faces are flipped")
       .result(&R::flips, "flips")
       .result("interior_edges", after(&DelaunayCensus::interior_edges))
       .result("non_delaunay_before",
@@ -236,6 +253,11 @@ Operation make_delaunay_operation() {
       .result("kept_seams", after(&DelaunayCensus::seams))
       .result("blocked_by_existing_edges", after(&DelaunayCensus::blocked))
       .result("blocked_by_folds", after(&DelaunayCensus::folds))
+      .result("kept_outside_selection",
+              [](const O& o, const R& r) -> std::optional<Value> {
+                if (!o.selection_only) return std::nullopt;
+                return field_value(r.after.unselected);
+              })
       .result(&R::budget_exhausted, "budget_exhausted")
       .messages([](const O&, const R& r) {
         std::vector<std::string> out;

@@ -14,6 +14,7 @@
 #include "hedge/error.h"
 #include "hedge/normals.h"
 #include "parallel.h"
+#include "selection.h"
 
 namespace hedge {
 namespace {
@@ -30,7 +31,8 @@ struct Rings {
   std::vector<char> curve;  // boundary vertex smoothed along its boundary curve (uniform 1D rule)
 };
 
-Rings make_rings(const Mesh& m, bool preserve_boundary) {
+// `selected`: per vertex, empty for all; unselected vertices get no ring and stay.
+Rings make_rings(const Mesh& m, bool preserve_boundary, const std::vector<std::uint8_t>& selected) {
   const std::size_t V = m.vertices_size();
   Rings r;
   r.offset.assign(V + 1, 0);
@@ -40,7 +42,7 @@ Rings make_rings(const Mesh& m, bool preserve_boundary) {
   for (Index i = 0; i < V; ++i) {
     const Vertex v(i);
     r.offset[i] = Index(r.neighbour.size());
-    if (m.is_deleted(v) || m.is_isolated(v)) continue;
+    if (m.is_deleted(v) || m.is_isolated(v) || (!selected.empty() && !selected[i])) continue;
     const Halfedge out = m.halfedge(v);
     if (m.is_boundary(out)) {
       if (preserve_boundary) continue;
@@ -134,7 +136,9 @@ SmoothReport smooth(Mesh& mesh, const SmoothOptions& options, Progress& progress
   report.lambda = lambda;
   report.mu = mu;
 
-  const Rings rings = make_rings(mesh, options.preserve_boundary);
+  const Rings rings =
+      make_rings(mesh, options.preserve_boundary,
+                 options.selection_only ? detail::selected_vertices(mesh) : std::vector<std::uint8_t>());
   const std::size_t V = mesh.vertices_size();
   for (Index v = 0; v < V; ++v) report.moved_vertices += rings.offset[v + 1] > rings.offset[v];
 
@@ -254,6 +258,9 @@ Operation smooth_operation() {
               "λ: how far each step moves a vertex toward the mean (0 to 1)")
       .option(&O::preserve_boundary, "preserve_boundary", "Preserve boundary",
               "keep boundary vertices fixed (otherwise smooth them along the boundary)")
+      .selection(&O::selection_only,
+                 "only the selected vertices move (those inside the selected faces when the host "
+                 "selects faces only)")
       .option(&O::pass_band, "pass_band", "Pass band", between(0.01, 0.5),
               "taubin only: k_PB, the frequency below which shapes pass unchanged (μ = -λ / (1 - k_PB λ))")
       .result("method",

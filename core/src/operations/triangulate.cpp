@@ -18,6 +18,7 @@
 
 #include "binding.h"
 #include "hedge/error.h"
+#include "selection.h"
 
 namespace hedge {
 namespace {
@@ -421,9 +422,11 @@ const char* triangulation_method_name(TriangulationMethod method) {
 TriangulateReport triangulate(Mesh& mesh, const TriangulateOptions& options, Progress& progress) {
   TriangulateReport report;
   std::vector<Face> polygons;
+  const std::vector<std::uint8_t> selected =
+      options.selection_only ? detail::selected_faces(mesh) : std::vector<std::uint8_t>();
   for (Face f : mesh.faces()) {
     const Halfedge h = mesh.halfedge(f);
-    if (mesh.next(mesh.next(mesh.next(h))) != h) polygons.push_back(f);
+    if (mesh.next(mesh.next(mesh.next(h))) != h && (selected.empty() || selected[f.idx()])) polygons.push_back(f);
   }
   report.polygons = polygons.size();
   if (polygons.empty()) return report;
@@ -480,6 +483,7 @@ Operation triangulate_operation() {
       .choice(&O::method, "method", "Method", {TriangulationMethod::min_area, TriangulationMethod::ear_clipping},
               triangulation_method_name,
               "min_area for the best triangles (dynamic programming), ear_clipping for speed")
+      .selection(&O::selection_only, "only the selected polygons are split; the others stay as they are")
       .result(
           "method",
           [](const O& o, const R&) -> std::optional<Value> { return std::string(triangulation_method_name(o.method)); })
