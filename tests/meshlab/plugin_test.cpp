@@ -293,6 +293,44 @@ TEST_F(PluginTest, NoOpKeepsEverythingIncludingSelection) {
   EXPECT_TRUE(after == before);
 }
 
+// The faces with selection `want`, each as its three corner positions from the smallest on, sorted.
+std::vector<std::vector<float>> faces_selected(const CMeshO& m, bool want) {
+  std::vector<std::vector<float>> out;
+  for (const CFaceO& f : m.face) {
+    if (f.IsD() || f.IsS() != want) continue;
+    std::vector<std::vector<float>> corners;
+    for (int j = 0; j < 3; ++j) corners.push_back({f.cP(j)[0], f.cP(j)[1], f.cP(j)[2]});
+    std::rotate(corners.begin(), std::min_element(corners.begin(), corners.end()), corners.end());
+    std::vector<float> flat;
+    for (const auto& c : corners) flat.insert(flat.end(), c.begin(), c.end());
+    out.push_back(flat);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+// MeshLab's face selection drives selection_only: faces outside it come back as they were.
+TEST_F(PluginTest, SelectionOnlyKeepsTheFacesOutsideTheSelection) {
+  for (const char* op_id : {"decimate", "smooth", "make_delaunay"}) {
+    SCOPED_TRACE(op_id);
+    Document doc(mesh_path("bunny.off"));
+    CMeshO& m = doc.model->cm;
+    std::vector<float> xs;
+    for (const CFaceO& f : m.face) xs.push_back(f.cP(0)[0]);
+    std::nth_element(xs.begin(), xs.begin() + std::ptrdiff_t(xs.size() / 2), xs.end());
+    const float median = xs[xs.size() / 2];
+    for (CFaceO& f : m.face)
+      if (f.cP(0)[0] < median) f.SetS();
+    const auto outside = faces_selected(m, false), inside = faces_selected(m, true);
+    RichParameterList parameters = doc.defaults(action_of(op_id));
+    parameters.setValue("selection_only", BoolValue(true));
+    ASSERT_TRUE(doc.apply(op_id, parameters)) << doc.log_text();
+    EXPECT_EQ(faces_selected(m, false), outside);
+    EXPECT_NE(faces_selected(m, true), inside);
+    if (std::string(op_id) == "decimate") EXPECT_LT(m.fn, static_cast<int>(outside.size() + inside.size()));
+  }
+}
+
 TEST_F(PluginTest, DeletedElementsAreSkippedAndTheResultIsCompact) {
   Document doc(mesh_path("bunny.off"));
   CMeshO& m = doc.model->cm;
