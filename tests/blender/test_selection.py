@@ -1,6 +1,6 @@
 # selection_only in Blender: the operators in Edit Mode follow its selection, hedge.run() the
-# mesh's stored one. Faces outside the selection come back as they were (decimate, triangulate,
-# make_delaunay); smoothing moves only the selected vertices; nothing selected changes nothing.
+# mesh's stored one. Faces outside the selection come back as they were (decimate, remesh,
+# triangulate, make_delaunay); smoothing moves only the selected vertices; nothing selected changes nothing.
 import os
 import sys
 
@@ -9,7 +9,7 @@ import bmesh  # noqa: E402
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 import unittest  # noqa: E402
-from blender_test import clear_scene, get, install_addon, mesh_path, run_tests, select_only  # noqa: E402
+from blender_test import clear_scene, get, install_addon, mesh_path, problems, run_tests, select_only  # noqa: E402
 
 hedge = install_addon()
 
@@ -89,6 +89,10 @@ class SelectionTest(unittest.TestCase):
 
     def test_make_delaunay_in_edit_mode(self):
         self.check_outside_kept("make_delaunay")
+
+    def test_remesh_in_edit_mode(self):
+        self.check_outside_kept("remesh", iterations=3)
+        self.assertFalse(problems(self.obj.data))
 
     def test_smooth_moves_only_selected_vertices(self):
         me = self.obj.data

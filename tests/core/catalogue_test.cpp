@@ -8,6 +8,7 @@
 #include <cmath>
 #include <regex>
 #include <set>
+#include <stdexcept>
 
 #include "hedge/error.h"
 #include "operations/binding.h"
@@ -79,7 +80,9 @@ TEST(Catalogue, ParametersAreChecked) {
     for (const ParamSpec& p : op.params) {
       std::vector<std::string> bad;
       switch (p.type) {
-        case ParamType::boolean: bad = {"maybe", "2"}; break;
+        case ParamType::boolean:
+          bad = {"maybe", "2"};
+          break;
         case ParamType::integer:
           bad = {"1.5", "abc", "-999999999999"};
           if (p.range.max) bad.push_back(std::to_string(static_cast<long long>(*p.range.max) + 1));
@@ -88,7 +91,9 @@ TEST(Catalogue, ParametersAreChecked) {
           bad = {"abc", "nan", "1e400", "-1e299"};
           if (p.range.max) bad.push_back(value_text(std::nextafter(*p.range.max, 1e300)));
           break;
-        case ParamType::choice: bad = {"no_such_choice"}; break;
+        case ParamType::choice:
+          bad = {"no_such_choice"};
+          break;
       }
       for (const auto& value : bad) {
         try {
@@ -100,7 +105,8 @@ TEST(Catalogue, ParametersAreChecked) {
         }
       }
       // The default, given explicitly as text, is accepted.
-      EXPECT_NO_THROW(resolve_params(op, std::map<std::string, std::string>{{p.id, p.default_text()}})) << op.id << "." << p.id;
+      EXPECT_NO_THROW(resolve_params(op, std::map<std::string, std::string>{{p.id, p.default_text()}}))
+          << op.id << "." << p.id;
     }
   }
 }
@@ -154,7 +160,8 @@ TEST(Catalogue, BindingTakesTypesAndDefaultsFromTheOptions) {
 
 TEST(Catalogue, TypedValuesResolve) {
   const Operation op = demo::operation();
-  ParamValues v = resolve_params(op, std::map<std::string, Value>{{"ratio", std::int64_t(1)}, {"mode", std::string("a")}});
+  ParamValues v =
+      resolve_params(op, std::map<std::string, Value>{{"ratio", std::int64_t(1)}, {"mode", std::string("a")}});
   EXPECT_EQ(v.get_real("ratio"), 1.0);
   EXPECT_EQ(v.get_int("count"), 3);
   EXPECT_TRUE(v.get_bool("flag"));
@@ -164,6 +171,16 @@ TEST(Catalogue, TypedValuesResolve) {
   EXPECT_THROW(resolve_params(op, std::map<std::string, Value>{{"mode", std::string("c")}}), Error);
   EXPECT_EQ(op.params[0].range_text(), "a number from 0 to 1");
   EXPECT_EQ(op.params[3].range_text(), "one of a, b");
+}
+
+// A choice whose default users could not pick is a mistake in the binding, caught at once.
+TEST(Catalogue, ChoiceRefusesADefaultOutsideItsValues) {
+  auto bind = [] {
+    auto run = [](Mesh&, const demo::Options&, Progress&) { return demo::Report{}; };
+    return Binding<demo::Options, demo::Report>("demo", "Demo", Category::measure, "a demo", run)
+        .choice(&demo::Options::mode, "mode", "Mode", {demo::Mode::a}, demo::mode_name, "m");
+  };
+  EXPECT_THROW(bind(), std::logic_error);
 }
 
 TEST(Catalogue, ReportRunsWithoutChangingAnything) {
@@ -182,7 +199,8 @@ TEST(Catalogue, ReportRunsWithoutChangingAnything) {
 TEST(Catalogue, ProgressCanCancel) {
   const Operation& op = find_operation("report");
   Progress stop([](double, const std::string&) { return false; });
-  EXPECT_THROW(run_operation(op, two_triangles(), resolve_params(op, std::map<std::string, std::string>{}), stop), Cancelled);
+  EXPECT_THROW(run_operation(op, two_triangles(), resolve_params(op, std::map<std::string, std::string>{}), stop),
+               Cancelled);
 }
 
 TEST(Catalogue, BadSoupIsRefusedWithItsReason) {

@@ -472,12 +472,13 @@ TEST(Remesh, CatalogueEntry) {
   const Operation& op = find_operation("remesh");
   EXPECT_EQ(op.title, "Isotropic Remesh");
   EXPECT_EQ(op.category, Category::remeshing);
-  ASSERT_EQ(op.params.size(), 5u);
+  ASSERT_EQ(op.params.size(), 6u);
   EXPECT_EQ(op.params[0].id, "target_edge_length");
   EXPECT_EQ(op.params[1].id, "iterations");
   EXPECT_EQ(op.params[2].id, "feature_angle");
   EXPECT_EQ(op.params[3].id, "preserve_boundary");
   EXPECT_EQ(op.params[4].id, "adaptive");
+  EXPECT_EQ(op.params[5].id, "selection_only");
   EXPECT_EQ(op.params[1].default_value, Value(std::int64_t(5)));
   EXPECT_EQ(op.params[2].default_value, Value(45.0));
   RunResult r =

@@ -27,6 +27,10 @@ struct RemeshOptions {
   //! Refuse (before starting) a target length that would make more triangles than this on
   //! the input's area (about area / (sqrt(3)/4 L^2), as equilateral triangles of side L).
   std::size_t max_faces = 200'000'000;
+  //! Only the selected faces (the "selected" face channel a host's selection fills) are
+  //! remeshed: edges of faces outside it are never split, collapsed or flipped, and their
+  //! vertices stay, so those faces and the border come back as they were.
+  bool selection_only = false;
 };
 
 struct RemeshReport {

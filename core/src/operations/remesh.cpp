@@ -17,6 +17,7 @@
 #include "hedge/geometry.h"
 #include "hedge/provenance.h"
 #include "parallel.h"
+#include "selection.h"
 #include "welded_copies.h"
 
 namespace hedge {
@@ -26,6 +27,7 @@ namespace {
 constexpr std::uint8_t kFeature = 1;  // only split: never collapsed, never flipped
 constexpr std::uint8_t kCurve = 2;    // a crease or a free boundary: its vertices slide along it
 constexpr std::uint8_t kPinned = 4;   // preserved boundary or attribute seam: its vertices stay put
+constexpr std::uint8_t kFrozen = 8;   // with selection_only, on a face outside the selection: not even split
 
 // What a vertex may do.
 enum class Kind : std::uint8_t { free, sliding, fixed };
@@ -184,9 +186,16 @@ void Remesher::classify() {
     return std::memcmp(c->element(a), c->element(b), c->stride()) == 0;
   };
 
+  const std::vector<std::uint8_t> selected =
+      options_.selection_only ? detail::selected_faces(mesh_) : std::vector<std::uint8_t>();
+  auto outside = [&](Halfedge h) { return !mesh_.is_boundary(h) && !selected[mesh_.face(h).idx()]; };
   for (Edge e : mesh_.edges()) {
     Halfedge h0 = Mesh::halfedge(e, 0), h1 = Mesh::halfedge(e, 1);
     std::uint8_t& flags = edge_flags_[e.idx()];
+    if (!selected.empty() && (outside(h0) || outside(h1))) {
+      flags = kFeature | kPinned | kFrozen;  // its vertices are pinned too, so the border stays
+      continue;
+    }
     if (mesh_.is_boundary(e)) {
       flags = options_.preserve_boundary ? (kFeature | kPinned) : kCurve;
       continue;
@@ -345,7 +354,7 @@ void Remesher::split_long_edges() {
     const Index n = static_cast<Index>(mesh_.edges_size());
     for (Index i = 0; i < n; ++i) {
       const Edge e(i);
-      if (mesh_.is_deleted(e)) continue;
+      if (mesh_.is_deleted(e) || (edge_flags_[i] & kFrozen)) continue;
       Halfedge h0 = Mesh::halfedge(e, 0), h1 = Mesh::halfedge(e, 1);
       Vertex a = mesh_.to_vertex(h1), b = mesh_.to_vertex(h0);
       double hi = 4.0 / 3.0 * size(a, b);
@@ -837,9 +846,19 @@ RemeshReport Remesher::run() {
   }
 
   progress_.update(0.0, "triangulating");
-  for (Face f : mesh_.faces())
-    if (mesh_.valence(f) > 3) ++report_.triangulated_faces;
-  if (report_.triangulated_faces) mesh_.triangulate();
+  if (options_.selection_only) {
+    // Polygons outside the selection stay: their edges are frozen (classify()).
+    const std::vector<std::uint8_t> selected = detail::selected_faces(mesh_);
+    std::vector<Face> polygons;
+    for (Face f : mesh_.faces())
+      if (mesh_.valence(f) > 3 && selected[f.idx()]) polygons.push_back(f);
+    for (Face f : polygons) mesh_.triangulate(f);
+    report_.triangulated_faces = polygons.size();
+  } else {
+    for (Face f : mesh_.faces())
+      if (mesh_.valence(f) > 3) ++report_.triangulated_faces;
+    if (report_.triangulated_faces) mesh_.triangulate();
+  }
 
   progress_.update(0.01, "building the distance tree");
   surface_ = TriangleTree(input_);
@@ -941,6 +960,9 @@ Operation remesh_operation() {
       .option(&O::adaptive, "adaptive", "Adaptive",
               "Let the edge length follow curvature: shorter where the surface bends (down to a quarter of "
               "the target), longer where it is flat (up to twice the target).")
+      .selection(&O::selection_only,
+                 "Only the selected faces are remeshed; faces outside the selection and the border stay as they "
+                 "are.")
       .result(&R::target_edge_length, "target_edge_length")
       .result(&R::input_faces, "input_faces")
       .result(&R::output_faces, "faces")
