@@ -9,7 +9,8 @@ import bmesh  # noqa: E402
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 import unittest  # noqa: E402
-from blender_test import clear_scene, get, install_addon, mesh_path, problems, run_tests, select_only  # noqa: E402
+from blender_test import (boundary_loops, clear_scene, get, install_addon, mesh_path, problems, run_tests,  # noqa: E402
+                          select_only)
 
 hedge = install_addon()
 
@@ -93,6 +94,34 @@ class SelectionTest(unittest.TestCase):
     def test_remesh_in_edit_mode(self):
         self.check_outside_kept("remesh", iterations=3)
         self.assertFalse(problems(self.obj.data))
+
+    def test_fill_holes_with_a_selected_border(self):
+        # Two holes cut in the bunny; the border of the left one selected, vertex by vertex.
+        me = self.obj.data
+        bpy.ops.object.mode_set(mode='EDIT')
+        bpy.ops.mesh.select_mode(type='VERT')
+        bm = bmesh.from_edit_mesh(me)
+        left = min(bm.verts, key=lambda v: v.co.x).co.copy()
+        right = max(bm.verts, key=lambda v: v.co.x).co.copy()
+        doomed = [f for f in bm.faces
+                  if any((v.co - left).length < 0.5 or (v.co - right).length < 0.5 for v in f.verts)]
+        bmesh.ops.delete(bm, geom=doomed, context='FACES_ONLY')
+        for element in list(bm.verts) + list(bm.edges) + list(bm.faces):
+            element.select_set(False)
+        for v in bm.verts:
+            if v.is_boundary and (v.co - left).length < 2:
+                v.select_set(True)
+        bm.select_flush_mode()
+        bmesh.update_edit_mesh(me)
+        self.obj.update_from_editmode()
+        self.assertEqual(boundary_loops(me), 2)
+        faces = len(me.polygons)
+        self.assertEqual(bpy.ops.mesh.hedge_fill_holes(selection_only=True), {'FINISHED'})
+        bpy.ops.object.mode_set(mode='OBJECT')
+        report = hedge.api.last_reports["fill_holes"]
+        self.assertEqual((report["holes_filled"], report["holes_not_selected"]), (1, 1))
+        self.assertEqual(boundary_loops(me), 1)
+        self.assertGreater(len(me.polygons), faces)
 
     def test_smooth_moves_only_selected_vertices(self):
         me = self.obj.data

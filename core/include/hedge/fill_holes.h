@@ -38,13 +38,17 @@ struct FillHolesOptions {
   //! its border would exceed it gets proportionally larger triangles.
   //! The bound keeps the fairing solve (sparse Cholesky, superlinear) to about a second.
   std::size_t max_new_vertices_per_hole = 30000;
+  //! Only holes whose every border vertex is selected (the "selected" vertex channel a host's
+  //! selection fills; without one, the vertices inside the face selection).
+  bool selection_only = false;
 };
 
 struct FillHolesReport {
   std::size_t holes_found = 0;  //!< boundary loops before filling
   std::size_t holes_filled = 0;
-  std::size_t holes_skipped = 0;    //!< left open: the three kinds below
-  std::size_t holes_too_large = 0;  //!< more than max_hole_edges edges
+  std::size_t holes_skipped = 0;       //!< left open: the four kinds below
+  std::size_t holes_too_large = 0;     //!< more than max_hole_edges edges
+  std::size_t holes_not_selected = 0;  //!< with selection_only, a border vertex not selected
   //! the border of a face with no neighbour, or a hole of three edges whose corners have a
   //! face already (filling would double it)
   std::size_t lone_faces = 0;

@@ -15,11 +15,12 @@
 #include <utility>
 #include <vector>
 
+#include "binding.h"
 #include "hedge/error.h"
 #include "hedge/limits.h"
 #include "hedge/provenance.h"
 #include "hedge/topology.h"
-#include "binding.h"
+#include "selection.h"
 
 namespace hedge {
 namespace {
@@ -735,7 +736,17 @@ FillHolesReport fill_holes(Mesh& input, const FillHolesOptions& options, Progres
 
   std::vector<Hole> to_fill;
   std::size_t total_edges = 0;
+  const std::vector<std::uint8_t> selected =
+      options.selection_only ? detail::selected_vertices(input) : std::vector<std::uint8_t>();
   for (const Hole& hole : holes) {
+    if (!selected.empty()) {
+      bool all = true;
+      for (Halfedge b : input.loop(hole.start)) all = all && selected[input.to_vertex(b).idx()];
+      if (!all) {
+        ++report.holes_not_selected;
+        continue;
+      }
+    }
     if (options.max_hole_edges && hole.edges > options.max_hole_edges) {
       ++report.holes_too_large;
       report.largest_skipped_edges = std::max(report.largest_skipped_edges, hole.edges);
@@ -757,7 +768,7 @@ FillHolesReport fill_holes(Mesh& input, const FillHolesOptions& options, Progres
     to_fill.push_back(hole);
     total_edges += hole.edges;
   }
-  report.holes_skipped = report.holes_too_large + report.lone_faces + report.slits;
+  report.holes_skipped = report.holes_too_large + report.lone_faces + report.slits + report.holes_not_selected;
   if (report.holes_too_large)
     report.messages.push_back(std::to_string(report.holes_too_large) + " holes with more than " +
                               std::to_string(options.max_hole_edges) + " edges left open (the largest has " +
@@ -821,10 +832,16 @@ Operation fill_holes_operation() {
       .option(&O::fair, "fair", "Fair patch",
               "Move the new vertices so the patch is smooth and blends with the surface "
               "(bi-Laplacian, Δ²x = 0).")
+      .selection(&O::selection_only, "Only holes whose border is selected are filled (every border vertex).")
       .result(&R::holes_found, "holes_found")
       .result(&R::holes_filled, "holes_filled")
       .result(&R::holes_skipped, "holes_skipped")
       .result(&R::holes_too_large, "holes_too_large")
+      .result("holes_not_selected",
+              [](const O& o, const R& r) -> std::optional<Value> {
+                if (!o.selection_only) return std::nullopt;
+                return field_value(r.holes_not_selected);
+              })
       .result(&R::lone_faces, "lone_faces_left_open")
       .result(&R::slits, "two_edge_slits_left_open")
       .result(&R::split_seams, "non_manifold_seams_left_open")
