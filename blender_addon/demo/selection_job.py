@@ -1,0 +1,124 @@
+# Selection only, as a Blender user runs it: in Edit Mode, half of a dragon selected (the faces
+# behind its middle, drawn blue), the Hedge Decimate operator with Selection only; the other
+# half (orange) and the border come back as they were. Prints the counts and renders a
+# before/after picture with Workbench (flat shading shows the facets).
+#   xvfb-run -a blender -b --factory-startup --python-exit-code 1 --python selection_job.py -- \
+#       --mesh dragon_res2.ply --out DIR [--zip PACKAGE] [--picture docs/blender_selection.png]
+import argparse
+import os
+import sys
+
+import bmesh
+import bpy
+from mathutils import Vector
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tools"))
+import hedge_install  # noqa: E402
+
+argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
+parser = argparse.ArgumentParser()
+parser.add_argument("--mesh", required=True)
+parser.add_argument("--out", required=True)
+parser.add_argument("--ratio", type=float, default=0.05)
+parser.add_argument("--picture", default="", help="also write a small copy of the picture here")
+parser.add_argument("--zip", default="", help="install this package first if hedge is not installed")
+args = parser.parse_args(argv)
+os.makedirs(args.out, exist_ok=True)
+
+try:
+    hedge_install.enable(quiet=True)
+except RuntimeError:
+    if not args.zip:
+        sys.exit("the hedge add-on is not installed (./run install, or pass --zip)")
+    hedge_install.install(args.zip)
+import hedge  # noqa: E402
+
+for obj in list(bpy.data.objects):
+    bpy.data.objects.remove(obj)
+
+dragon = hedge.api.import_file(args.mesh, "dragon")
+me = dragon.data
+for name, colour in (("kept", (0.8, 0.55, 0.3, 1)), ("selected", (0.3, 0.5, 0.85, 1))):
+    material = bpy.data.materials.new(name)
+    material.diffuse_color = colour
+    me.materials.append(material)
+
+# Edit Mode: the faces past the middle of the longest axis selected and given the blue material.
+bpy.context.view_layer.objects.active = dragon
+dragon.select_set(True)
+bpy.ops.object.mode_set(mode='EDIT')
+bpy.ops.mesh.select_mode(type='FACE')
+bm = bmesh.from_edit_mesh(me)
+axis = max(range(3), key=lambda k: dragon.dimensions[k])
+middle = sorted(f.calc_center_median()[axis] for f in bm.faces)[len(bm.faces) // 2]
+for f in bm.faces:
+    inside = f.calc_center_median()[axis] > middle
+    f.select_set(inside)
+    f.material_index = 1 if inside else 0
+bm.select_flush_mode()
+bmesh.update_edit_mesh(me)
+dragon.update_from_editmode()
+faces_before, selected_before = len(me.polygons), sum(p.select for p in me.polygons)
+
+before = dragon.copy()
+before.data = me.copy()
+before.name = "before"
+bpy.context.collection.objects.link(before)
+
+result = bpy.ops.mesh.hedge_decimate(selection_only=True, target_ratio=args.ratio)
+bpy.ops.object.mode_set(mode='OBJECT')
+if result != {'FINISHED'}:
+    sys.exit(f"the operator did not finish: {result}")
+selected_after = sum(p.select for p in me.polygons)
+print(f"  selection-only decimate to {args.ratio:.0%}: {faces_before:,} -> {len(me.polygons):,} faces; "
+      f"selected {selected_before:,} -> {selected_after:,}, the other {faces_before - selected_before:,} kept")
+
+scale = 1.15 / max(before.dimensions)
+for obj, x in ((before, -0.6), (dragon, 0.6)):
+    obj.data.polygons.foreach_set("use_smooth", [False] * len(obj.data.polygons))
+    obj.rotation_euler = (1.5708, 0, 0.5)
+    obj.location = (0, 0, 0)
+    obj.scale = (scale, scale, scale)
+    bpy.context.view_layer.update()
+    centre = sum((obj.matrix_world @ Vector(c) for c in obj.bound_box), Vector()) / 8
+    obj.location = Vector((x, 0, 0)) - centre
+for text, x, n, s in (("before", -0.6, faces_before, selected_before),
+                      ("after", 0.6, len(me.polygons), selected_after)):
+    curve = bpy.data.curves.new(text, 'FONT')
+    curve.body = f"{text}: {n:,} faces, {s:,} selected"
+    curve.size = 0.06
+    curve.align_x = 'CENTER'
+    label = bpy.data.objects.new(text + " label", curve)
+    label.location = (x, 0, -0.5)
+    label.rotation_euler = (1.5708, 0, 0)
+    bpy.context.collection.objects.link(label)
+camera_data = bpy.data.cameras.new("camera")
+camera_data.type = 'ORTHO'
+camera_data.ortho_scale = 2.5
+camera = bpy.data.objects.new("camera", camera_data)
+camera.location = (0, -4, 0)
+camera.rotation_euler = (1.5708, 0, 0)
+bpy.context.collection.objects.link(camera)
+scene = bpy.context.scene
+scene.camera = camera
+scene.render.engine = 'BLENDER_WORKBENCH'
+scene.display.shading.light = 'STUDIO'
+scene.display.shading.color_type = 'MATERIAL'
+scene.display.shading.show_cavity = True
+scene.render.resolution_x = 1400
+scene.render.resolution_y = 700
+scene.render.resolution_percentage = 100
+scene.world = bpy.data.worlds.new("world") if scene.world is None else scene.world
+scene.world.color = (1, 1, 1)
+scene.view_settings.view_transform = 'Standard'
+scene.render.image_settings.file_format = 'PNG'
+scene.render.filepath = os.path.join(args.out, "blender_selection.png")
+bpy.ops.render.render(write_still=True)
+print(f"  rendered {scene.render.filepath}")
+if args.picture:
+    image = bpy.data.images.load(scene.render.filepath)
+    image.scale(700, 350)
+    image.filepath_raw = os.path.abspath(args.picture)
+    image.file_format = 'PNG'
+    image.save()
+    print(f"  small copy {args.picture} ({os.path.getsize(args.picture) // 1024} KB)")
