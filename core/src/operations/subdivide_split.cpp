@@ -1,25 +1,26 @@
-// Loop, Catmull–Clark and midpoint subdivision (subdivide.h): one step splits
-// every edge at an edge point and every face 1 -> 4 or into quads around a face
-// point.
+// Loop, Catmull–Clark and midpoint subdivision (subdivide.h): one step splits every edge at an
+// edge point and every face 1 -> 4 or into quads around a face point. The three schemes share
+// the connectivity; they differ only in the stencils of the new points (below, one set per
+// scheme).
 #include <cstddef>
 #include <vector>
 
+#include "hedge/error.h"
 #include "parallel.h"
 #include "subdivide_refine.h"
 
 namespace hedge::subdivision {
 namespace {
 
-//! How each face splits: triangles of Loop and midpoint 1 -> 4 at the edge
-//! points; faces of Catmull–Clark and polygons of midpoint into one quad per
-//! corner around a face point. On a mesh of triangles split 1 -> 4 (every Loop
-//! step) the offsets are arithmetic and no table is built.
+//! How each face splits: triangles of Loop and midpoint 1 -> 4 at the edge points; faces of
+//! Catmull–Clark and polygons of midpoint into one quad per corner around a face point.
+//! On a mesh of triangles split 1 -> 4 (every Loop step) the offsets are arithmetic and no
+//! table is built.
 struct SplitPlan {
-  bool uniform = false;           // all faces are triangles split 1 -> 4
-  std::vector<Index> face_point;  // per face: index of its face point among the added vertices
-                                  // after the edge points, or invalid
-  std::vector<Index> inner_edge;  // per face: first of its new interior edges
-                                  // (counted after the 2E halves)
+  bool uniform = false;  // all faces are triangles split 1 -> 4
+  std::vector<Index>
+      face_point;  // per face: index of its face point among the added vertices after the edge points, or invalid
+  std::vector<Index> inner_edge;  // per face: first of its new interior edges (counted after the 2E halves)
   std::vector<Index> child_face;  // per face: first child face
   std::vector<Index> face_of_point;
   Index inner_edges = 0, child_faces = 0;
@@ -73,7 +74,139 @@ SplitPlan plan_split(const Mesh& m, SubdivisionScheme scheme) {
   return plan;
 }
 
+// ---- the stencils -----------------------------------------------------------------------------
+
+//! What a step's stencils read: the mesh, its creases (per edge, empty for none) and where the
+//! face points are. Added vertices: edge points V..V+E-1, then face points.
+struct SplitStencils {
+  const Mesh& m;
+  const std::vector<bool>& crease;
+  const SplitPlan& plan;
+  Index V = 0, E = 0;
+
+  Index face_point(Face f) const { return V + E + plan.point_of_face(f.idx()); }
+  bool is_sharp(Edge e) const { return m.is_boundary(e) || (!crease.empty() && crease[e.idx()]); }
+};
+
+//! A face point, for Catmull–Clark's faces and midpoint's polygons: the centroid.
+void face_point(const Mesh& m, Face f, Stencil& s) {
+  const float w = 1.0f / float(face_size(m, f));
+  for (Vertex c : m.vertices(f)) s.add(c.idx(), w);
+}
+
+//! The midpoint of e: midpoint's every edge point, and the edge point of a boundary edge or a
+//! crease under Loop and Catmull–Clark (a sharp edge is refined as a curve of its own).
+void edge_midpoint(const Mesh& m, Edge e, Stencil& s) {
+  s.add(m.to_vertex(Mesh::halfedge(e, 0)).idx(), 0.5f);
+  s.add(m.to_vertex(Mesh::halfedge(e, 1)).idx(), 0.5f);
+}
+
+void midpoint_edge_point(const SplitStencils& r, Edge e, Stencil& s) { edge_midpoint(r.m, e, s); }
+
+//! Loop: 3/8 for the edge's ends, 1/8 for the opposite corners of its two triangles.
+void loop_edge_point(const SplitStencils& r, Edge e, Stencil& s) {
+  if (r.is_sharp(e)) return edge_midpoint(r.m, e, s);
+  const Mesh& m = r.m;
+  const Halfedge h0 = Mesh::halfedge(e, 0), h1 = Mesh::halfedge(e, 1);
+  s.add(m.to_vertex(h0).idx(), 0.375f);
+  s.add(m.to_vertex(h1).idx(), 0.375f);
+  s.add(m.to_vertex(m.next(h0)).idx(), 0.125f);
+  s.add(m.to_vertex(m.next(h1)).idx(), 0.125f);
+}
+
+//! Catmull–Clark: the mean of the edge's ends and its two faces' points.
+void catmull_clark_edge_point(const SplitStencils& r, Edge e, Stencil& s) {
+  if (r.is_sharp(e)) return edge_midpoint(r.m, e, s);
+  const Mesh& m = r.m;
+  const Halfedge h0 = Mesh::halfedge(e, 0), h1 = Mesh::halfedge(e, 1);
+  s.add(m.to_vertex(h0).idx(), 0.25f);
+  s.add(m.to_vertex(h1).idx(), 0.25f);
+  s.add(r.face_point(m.face(h0)), 0.25f);
+  s.add(r.face_point(m.face(h1)), 0.25f);
+}
+
+//! The rules of old vertices that Loop and Catmull–Clark share: isolated vertices, creases and
+//! boundaries. Fills s and returns true when one applies; false leaves v to the smooth rule.
+bool sharp_vertex(const SplitStencils& r, Vertex v, Stencil& s) {
+  const Mesh& m = r.m;
+  const Halfedge out_h = m.halfedge(v);
+  if (!out_h.is_valid()) {
+    s.add(v.idx(), 1.0f);
+    return true;
+  }
+  if (!r.crease.empty()) {
+    // Hoppe et al. 1994 / DeRose et al. 1998, boundary edges counting as creases: a corner
+    // (3 or more) stays, two interior creases give the curve rule along them, a dart (one)
+    // falls through to the smooth rule, a plain boundary vertex to the boundary rule.
+    const SharpEdges sharp = sharp_edges(m, r.crease, v);
+    if (sharp.count >= 3) {
+      s.add(v.idx(), 1.0f);
+      return true;
+    }
+    if (sharp.count == 2 && !m.is_boundary(out_h)) {
+      s.add(v.idx(), 0.75f);
+      s.add(m.to_vertex(sharp.out[0]).idx(), 0.125f);
+      s.add(m.to_vertex(sharp.out[1]).idx(), 0.125f);
+      return true;
+    }
+  }
+  if (m.is_boundary(out_h)) {
+    // Cubic B-spline on the boundary curve: the two boundary neighbours 1/8 each.
+    s.add(v.idx(), 0.75f);
+    s.add(m.to_vertex(out_h).idx(), 0.125f);
+    s.add(m.from_vertex(m.prev(out_h)).idx(), 0.125f);
+    return true;
+  }
+  return false;
+}
+
+//! Midpoint moves nothing.
+void midpoint_vertex(const SplitStencils&, Vertex v, Stencil& s) { s.add(v.idx(), 1.0f); }
+
+//! Loop: the vertex keeps 1 - n beta(n), each of its n neighbours beta(n).
+void loop_vertex(const SplitStencils& r, Vertex v, Stencil& s) {
+  if (sharp_vertex(r, v, s)) return;
+  // One walk around v gathers the ring; the weights depend on its size, set afterwards.
+  s.add(v.idx(), 0.0f);
+  for (Halfedge h : r.m.outgoing(v)) s.add(r.m.to_vertex(h).idx(), 0.0f);
+  const std::size_t n = s.size() - 1;
+  const float beta = float(loop_beta(n));
+  s.weight(0) = float(1.0 - double(n) * double(beta));
+  for (std::size_t i = 1; i <= n; ++i) s.weight(i) = beta;
+}
+
+//! Catmull–Clark: (Q + 2R + (n - 3) S) / n with Q the mean face point, R the mean edge
+//! midpoint: the vertex keeps (n - 2) / n, each neighbour and face point 1 / n^2.
+void catmull_clark_vertex(const SplitStencils& r, Vertex v, Stencil& s) {
+  if (sharp_vertex(r, v, s)) return;
+  // One walk around v gathers the ring; the weights depend on its size, set afterwards.
+  s.add(v.idx(), 0.0f);
+  for (Halfedge h : r.m.outgoing(v)) {
+    s.add(r.m.to_vertex(h).idx(), 0.0f);
+    s.add(r.face_point(r.m.face(h)), 0.0f);
+  }
+  const std::size_t n = (s.size() - 1) / 2;
+  s.weight(0) = float(n - 2) / float(n);
+  for (std::size_t i = 1; i <= 2 * n; ++i) s.weight(i) = 1.0f / float(n * n);
+}
+
+//! A step's positions and vertex properties under one scheme's rules, bound at compile time
+//! so that the stencil loops do not branch on the scheme.
+template <auto edge_point, auto vertex_point>
+void refine_split_vertices(const SplitStencils& r, Mesh& out, const VertexRule& rule, unsigned threads) {
+  auto added = [&](Index k, Stencil& s) {
+    if (k >= r.E)
+      face_point(r.m, Face(r.plan.face_of_point[k - r.E]), s);
+    else
+      edge_point(r, Edge(k), s);
+  };
+  auto even = [&](Vertex v, Stencil& s) { vertex_point(r, v, s); };
+  refine_vertices(r.m, out, rule, threads, added, even);
+}
+
 }  // namespace
+
+// ---- the step -----------------------------------------------------------------------------------
 
 Mesh split_step(const Mesh& m, SubdivisionScheme scheme, const std::vector<bool>& crease, unsigned threads,
                 Progress& progress, double from, double to) {
@@ -88,14 +221,12 @@ Mesh split_step(const Mesh& m, SubdivisionScheme scheme, const std::vector<bool>
   const bool corner_props = m.halfedge_properties().count() > 0;
   const bool edge_props = m.edge_properties().count() > 0;
   const bool face_props = m.face_properties().count() > 0;
-  // New half-edge -> corner slot (see refine_corners), new edge -> old edge,
-  // child -> parent face.
+  // New half-edge -> corner slot (see refine_corners), new edge -> old edge, child -> parent face.
   std::vector<Index> hmap(corner_props ? std::size_t(2) * E2 : 0), emap(edge_props ? E2 : 0), fmap(face_props ? F2 : 0);
   const Index centroid_slot = 2 * H, default_corner = 2 * H + FP;
 
-  // Faces: the halves of their half-edges, the interior edges and the child
-  // faces. h[i] points to corner c_i; m_i is the edge point of h[i] (between
-  // c_{i-1} and c_i).
+  // Faces: the halves of their half-edges, the interior edges and the child faces.
+  // h[i] points to corner c_i; m_i is the edge point of h[i] (between c_{i-1} and c_i).
   auto split_face = [&](Index f, const Halfedge* h, Index n) {
     const Index ff = plan.first_child(f), ie = 2 * E + plan.first_inner_edge(f);
     auto inner = [&](Index k, unsigned side) { return Halfedge(2 * (ie + k % n) + side); };
@@ -109,9 +240,8 @@ Mesh split_step(const Mesh& m, SubdivisionScheme scheme, const std::vector<bool>
     }
     const Index point = plan.point_of_face(f);
     if (point == kInvalidIndex) {
-      // Corner triangle i: c_i, m_{i+1}, m_i; centre triangle m_0, m_1, m_2.
-      // Interior edge i joins m_{i+1} and m_i; its side 0 lies in corner
-      // triangle i, side 1 in the centre.
+      // Corner triangle i: c_i, m_{i+1}, m_i; centre triangle m_0, m_1, m_2. Interior edge i
+      // joins m_{i+1} and m_i; its side 0 lies in corner triangle i, side 1 in the centre.
       const Face centre(ff + 3);
       for (Index i = 0; i < 3; ++i) {
         const Index j = i == 2 ? 0 : i + 1;
@@ -137,8 +267,8 @@ Mesh split_step(const Mesh& m, SubdivisionScheme scheme, const std::vector<bool>
       if (face_props)
         for (Index c = 0; c < 4; ++c) fmap[ff + c] = f;
     } else {
-      // Quad i: c_i, m_{i+1}, face point, m_i. Interior edge k joins the face
-      // point and m_k; its side 0 runs face point -> m_k.
+      // Quad i: c_i, m_{i+1}, face point, m_i. Interior edge k joins the face point and m_k;
+      // its side 0 runs face point -> m_k.
       const Vertex fp(V + E + point);
       for (Index i = 0; i < n; ++i) {
         const Halfedge a = second_half(h[i]), b = first_half(h[(i + 1) % n]), c = inner(i + 1, 1), d = inner(i, 0);
@@ -181,8 +311,7 @@ Mesh split_step(const Mesh& m, SubdivisionScheme scheme, const std::vector<bool>
   });
   progress.update(from + 0.3 * (to - from), "subdividing: connectivity");
 
-  // Edges: boundary half-edges split in two along their hole; edge points'
-  // half-edges.
+  // Edges: boundary half-edges split in two along their hole; edge points' half-edges.
   parallel_for(E, threads, [&](std::size_t lo, std::size_t hi) {
     for (Index e = Index(lo); e < hi; ++e) {
       const Vertex mid(V + e);
@@ -213,89 +342,24 @@ Mesh split_step(const Mesh& m, SubdivisionScheme scheme, const std::vector<bool>
   rule.V = V;
   rule.added = E + FP;
   rule.phases = {{E, E + FP}, {0, E}};  // edge points of Catmull–Clark read face points
-  auto face_point_index = [&](Face f) { return V + E + plan.point_of_face(f.idx()); };
-  auto added = [&](Index k, Stencil& s) {
-    if (k >= E) {
-      const Face f(plan.face_of_point[k - E]);
-      const float w = 1.0f / float(face_size(m, f));
-      for (Vertex c : m.vertices(f)) s.add(c.idx(), w);
-      return;
-    }
-    const Halfedge h0 = Mesh::halfedge(Edge(k), 0), h1 = Mesh::halfedge(Edge(k), 1);
-    const Index a = m.to_vertex(h0).idx(), b = m.to_vertex(h1).idx();
-    if (scheme == SubdivisionScheme::midpoint || m.is_boundary(Edge(k)) || (!crease.empty() && crease[k])) {
-      s.add(a, 0.5f);
-      s.add(b, 0.5f);
-    } else if (scheme == SubdivisionScheme::loop) {
-      s.add(a, 0.375f);
-      s.add(b, 0.375f);
-      s.add(m.to_vertex(m.next(h0)).idx(), 0.125f);
-      s.add(m.to_vertex(m.next(h1)).idx(), 0.125f);
-    } else {
-      s.add(a, 0.25f);
-      s.add(b, 0.25f);
-      s.add(face_point_index(m.face(h0)), 0.25f);
-      s.add(face_point_index(m.face(h1)), 0.25f);
-    }
-  };
-  auto even = [&](Vertex v, Stencil& s) {
-    const Halfedge out_h = m.halfedge(v);
-    if (scheme == SubdivisionScheme::midpoint || !out_h.is_valid()) {
-      s.add(v.idx(), 1.0f);
-      return;
-    }
-    if (!crease.empty()) {
-      // Hoppe et al. 1994 / DeRose et al. 1998, boundary edges counting as
-      // creases: a corner (3 or more) stays, two interior creases give the
-      // curve rule along them, a dart (one) falls through to the smooth rule, a
-      // plain boundary vertex to the boundary rule.
-      const SharpEdges sharp = sharp_edges(m, crease, v);
-      if (sharp.count >= 3) {
-        s.add(v.idx(), 1.0f);
-        return;
-      }
-      if (sharp.count == 2 && !m.is_boundary(out_h)) {
-        s.add(v.idx(), 0.75f);
-        s.add(m.to_vertex(sharp.out[0]).idx(), 0.125f);
-        s.add(m.to_vertex(sharp.out[1]).idx(), 0.125f);
-        return;
-      }
-    }
-    if (m.is_boundary(out_h)) {
-      // Cubic B-spline on the boundary curve: the two boundary neighbours 1/8
-      // each.
-      s.add(v.idx(), 0.75f);
-      s.add(m.to_vertex(out_h).idx(), 0.125f);
-      s.add(m.from_vertex(m.prev(out_h)).idx(), 0.125f);
-      return;
-    }
-    // One walk around v gathers the ring; the weights depend on its size, set
-    // afterwards.
-    s.add(v.idx(), 0.0f);
-    if (scheme == SubdivisionScheme::loop) {
-      for (Halfedge h : m.outgoing(v)) s.add(m.to_vertex(h).idx(), 0.0f);
-      const std::size_t n = s.size() - 1;
-      const float beta = float(loop_beta(n));
-      s.weight(0) = float(1.0 - double(n) * double(beta));
-      for (std::size_t i = 1; i <= n; ++i) s.weight(i) = beta;
-    } else {
-      // (Q + 2R + (n - 3) S) / n with Q the mean face point, R the mean edge
-      // midpoint: the vertex keeps (n - 2) / n, each neighbour and face point 1
-      // / n^2.
-      for (Halfedge h : m.outgoing(v)) {
-        s.add(m.to_vertex(h).idx(), 0.0f);
-        s.add(face_point_index(m.face(h)), 0.0f);
-      }
-      const std::size_t n = (s.size() - 1) / 2;
-      s.weight(0) = float(n - 2) / float(n);
-      for (std::size_t i = 1; i <= 2 * n; ++i) s.weight(i) = 1.0f / float(n * n);
-    }
-  };
-  refine_vertices(m, out, rule, threads, added, even);
+  const SplitStencils stencils{m, crease, plan, V, E};
+  switch (scheme) {
+    case SubdivisionScheme::loop:
+      refine_split_vertices<loop_edge_point, loop_vertex>(stencils, out, rule, threads);
+      break;
+    case SubdivisionScheme::catmull_clark:
+      refine_split_vertices<catmull_clark_edge_point, catmull_clark_vertex>(stencils, out, rule, threads);
+      break;
+    case SubdivisionScheme::midpoint:
+      refine_split_vertices<midpoint_edge_point, midpoint_vertex>(stencils, out, rule, threads);
+      break;
+    case SubdivisionScheme::sqrt3:
+      throw Error("subdivide: sqrt3 has a step of its own");
+  }
   progress.update(from + 0.8 * (to - from), "subdividing: attributes");
 
-  // Corners: a midpoint corner per old inner half-edge h (between h's and
-  // prev(h)'s corners), then a centroid corner per face point.
+  // Corners: a midpoint corner per old inner half-edge h (between h's and prev(h)'s corners),
+  // then a centroid corner per face point.
   refine_corners(m, out, std::size_t(H) + FP, hmap, threads, [&](const std::vector<Target>& all, unsigned t) {
     parallel_for(H, t, [&](std::size_t lo, std::size_t hi) {
       for (Index h = Index(lo); h < hi; ++h) {
