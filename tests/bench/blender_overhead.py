@@ -28,14 +28,23 @@ def option(name, default):
 
 
 def read_floor(me):
-    """Positions and loops out of Blender, as the exchange reads them."""
+    """Positions and loops out of Blender by the fastest way the running Blender has: 4.0+
+    keeps the corners' vertices as the ".corner_vert" attribute, read in one copy, and the
+    polygons' loops in order; 3.x reads the loops' property."""
     nv, nl, nf = len(me.vertices), len(me.loops), len(me.polygons)
     positions = np.empty(nv * 3, np.float32)
     me.vertices.foreach_get("co", positions)
-    sizes = np.empty(nf, np.int32)
-    me.polygons.foreach_get("loop_total", sizes)
     corners = np.empty(nl, np.int32)
-    me.loops.foreach_get("vertex_index", corners)
+    corner_vert = me.attributes.get(".corner_vert")
+    if corner_vert is not None:
+        starts = np.empty(nf, np.int32)
+        me.polygons.foreach_get("loop_start", starts)
+        sizes = np.diff(np.append(starts, np.int32(nl))).astype(np.int32)
+        corner_vert.data.foreach_get("value", corners)
+    else:
+        sizes = np.empty(nf, np.int32)
+        me.polygons.foreach_get("loop_total", sizes)
+        me.loops.foreach_get("vertex_index", corners)
     return positions, sizes, corners
 
 
