@@ -60,16 +60,57 @@ EDGE_FLAGS = (("use_seam", "uv_seam"), ("use_edge_sharp", "sharp_edge"), ("use_f
 _EDGE_PROPERTIES = bpy.types.MeshEdge.bl_rna.properties
 # 3.x: bevel weights and creases are properties present when the mesh's has_* says so.
 LEGACY_LAYERS = "has_bevel_weight_vertex" in bpy.types.Mesh.bl_rna.properties
-# 4.0 and later keep the mesh's own data as attributes too (".corner_vert", ".edge_verts",
-# ".select_vert", "material_index", "sharp_face", ...): read there, 10 to 25 times faster than
-# through the element properties, and not read at all when absent, which means every element
-# has the default. 3.x reads the properties.
-BUILTIN_ATTRIBUTES = not LEGACY_LAYERS
-# Edge flags 4.0+ keeps as hidden attributes (4.x's seams), read like the others.
-HIDDEN_EDGE_FLAGS = {"use_seam": ".uv_seam"}
 LEGACY_EDGE_LAYERS = (("has_crease_edge", "crease"), ("has_bevel_weight_edge", "bevel_weight"))
 # 4.0+: node groups declare their sockets through `interface` (3.x: inputs/outputs).
 NODE_INTERFACE = "interface" in bpy.types.NodeTree.bl_rna.properties
+# Blender moves the mesh's own data from element flags into attributes version by version
+# (3.4: selection, hiding, materials; 3.6: corners; 4.0: edges, smooth shading, sharp edges;
+# 4.x: seams as ".uv_seam", 5.0: "uv_seam"). Where it keeps one as an attribute, it is read
+# there, 10 to 25 times faster than through the element properties, and not at all when the
+# mesh has no such attribute (every element has the default). Which ones, is found once on a
+# scratch mesh (builtin_attributes()).
+_BUILTIN_PROBE = (("vertices", "select", True, False), ("vertices", "hide", True, False),
+                  ("polygons", "select", True, False), ("polygons", "hide", True, False),
+                  ("polygons", "material_index", 1, 0), ("polygons", "use_smooth", True, False),
+                  ("edges", "use_seam", True, False), ("edges", "use_edge_sharp", True, False),
+                  ("edges", "use_freestyle_mark", True, False))
+_builtin_attributes = None
+
+
+def _first_values(me):
+    return {a.name: a.data[0].value for a in me.attributes if a.data_type in ('BOOLEAN', 'INT') and len(a.data)}
+
+
+def builtin_attributes():
+    """{(collection, property): attribute name} for the element data the running Blender keeps
+    as attributes (("polygons", "use_smooth") is held inverted, as "sharp_face"), and
+    ".corner_vert" / ".edge_verts" for the corners' and edges' vertices. Found by setting each
+    property of a scratch triangle two ways and seeing which attribute follows."""
+    global _builtin_attributes
+    if _builtin_attributes is not None:
+        return _builtin_attributes
+    found = {}
+    me = bpy.data.meshes.new("hedge probe")
+    try:
+        me.from_pydata([(0, 0, 0), (1, 0, 0), (0, 1, 0)], [], [(0, 1, 2)])
+        for name in (".corner_vert", ".edge_verts"):
+            if name in me.attributes:
+                found[name] = name
+        for collection, prop, first, second in _BUILTIN_PROBE:
+            element = getattr(me, collection)[0]
+            if prop not in element.bl_rna.properties:
+                continue
+            setattr(element, prop, first)
+            at_first = _first_values(me)
+            setattr(element, prop, second)
+            at_second = _first_values(me)
+            changed = [n for n, v in at_first.items() if n in at_second and at_second[n] != v]
+            if len(changed) == 1 and (prop != "use_smooth" or changed[0] == "sharp_face"):
+                found[(collection, prop)] = changed[0]
+    finally:
+        bpy.data.meshes.remove(me)
+    _builtin_attributes = found
+    return found
 
 
 def _get(collection, prop, n, dtype, components=1):
@@ -80,12 +121,21 @@ def _get(collection, prop, n, dtype, components=1):
 
 
 def _builtin(me, name, n, dtype, default, components=1):
-    """Built-in datum `name` from its attribute (4.0+): all `default` when the mesh has none."""
+    """A datum Blender keeps as attribute `name`: all `default` when the mesh has none."""
     attribute = me.attributes.get(name)
     if attribute is None:
         values = np.full(n * components, default, dtype)
         return values.reshape(n, components) if components > 1 else values
     return _get(attribute.data, "value", n, dtype, components)
+
+
+def _flag(me, collection, prop, n, dtype):
+    """An element property (selection, hiding, material, edge flags), from its attribute where
+    the running Blender keeps one."""
+    name = builtin_attributes().get((collection, prop))
+    if name is not None:
+        return _builtin(me, name, n, dtype, 0)
+    return _get(getattr(me, collection), prop, n, dtype)
 
 
 def _set(collection, prop, values):
@@ -121,13 +171,15 @@ def read_mesh(me):
     d = MeshData()
     nv, nl, nf, ne = len(me.vertices), len(me.loops), len(me.polygons), len(me.edges)
     positions = _get(me.vertices, "co", nv, np.float32, 3)
+    builtin = builtin_attributes()
     loop_start = _get(me.polygons, "loop_start", nf, np.int32)
-    if BUILTIN_ATTRIBUTES:
-        # Polygons' loops are consecutive and in order (face offsets): the sizes are the steps.
-        loop_total = np.diff(np.append(loop_start, np.int32(nl))).astype(np.int32)
+    loop_total = np.diff(np.append(loop_start, np.int32(nl))).astype(np.int32)
+    if nf and not (loop_start[0] == 0 and np.all(loop_total > 0)):
+        # Loops not in polygon order (possible before 3.6): their sizes are read.
+        loop_total = _get(me.polygons, "loop_total", nf, np.int32)
+    if ".corner_vert" in builtin:
         vertex_index = _builtin(me, ".corner_vert", nl, np.int32, 0)
     else:
-        loop_total = _get(me.polygons, "loop_total", nf, np.int32)
         vertex_index = _get(me.loops, "vertex_index", nl, np.int32)
     starts = np.zeros(nf, np.int64)
     if nf:
@@ -192,16 +244,13 @@ def read_mesh(me):
             channels.append(("attr:" + name, domain, values))
             d.attributes.append((name, attr.data_type, attr.domain))
 
-    if BUILTIN_ATTRIBUTES:
-        material = _builtin(me, "material_index", nf, np.int32, 0)
+    material = _flag(me, "polygons", "material_index", nf, np.int32)
+    if ("polygons", "use_smooth") in builtin:
         smooth = ~_builtin(me, "sharp_face", nf, np.bool_, False)
-        flags = [_builtin(me, name, n, np.bool_, False)
-                 for name, n in ((".select_vert", nv), (".select_poly", nf), (".hide_vert", nv), (".hide_poly", nf))]
     else:
-        material = _get(me.polygons, "material_index", nf, np.int32)
         smooth = _get(me.polygons, "use_smooth", nf, np.bool_)
-        flags = [_get(collection, prop, n, np.bool_) for collection, prop, n in (
-            (me.vertices, "select", nv), (me.polygons, "select", nf), (me.vertices, "hide", nv), (me.polygons, "hide", nf))]
+    flags = [_flag(me, collection, prop, n, np.bool_) for collection, prop, n in (
+        ("vertices", "select", nv), ("polygons", "select", nf), ("vertices", "hide", nv), ("polygons", "hide", nf))]
     channels.append(("material", "face", material))
     channels.append(("smooth", "face", smooth.view(np.uint8)))
     for (name, domain), values in zip((("selected", "vertex"), ("selected", "face"), ("hidden", "vertex"),
@@ -211,27 +260,23 @@ def read_mesh(me):
         channels.append(("bevel_weight", "vertex", _get(me.vertices, "bevel_weight", nv, np.float32)))
     channels.append(("blender:vertex", "vertex", np.arange(nv, dtype=np.int32)))
 
-    if BUILTIN_ATTRIBUTES:
-        d.edges = _builtin(me, ".edge_verts", ne, np.int32, 0, 2)
-    else:
-        d.edges = _get(me.edges, "vertices", ne, np.int32, 2)
     for prop, attribute in EDGE_FLAGS:
         if prop not in _EDGE_PROPERTIES or attribute in me.attributes:
             continue
-        if BUILTIN_ATTRIBUTES and (prop in HIDDEN_EDGE_FLAGS or prop == "use_edge_sharp"):
-            # Kept as an attribute: absent, no edge has the flag.
-            hidden = HIDDEN_EDGE_FLAGS.get(prop)
-            if hidden is None or hidden not in me.attributes:
-                continue
-            values = _builtin(me, hidden, ne, np.bool_, False)
-        else:
-            values = _get(me.edges, prop, ne, np.bool_)
+        values = _flag(me, "edges", prop, ne, np.bool_)
         if values.any():
             d.edge_data[prop] = values
     if LEGACY_LAYERS:
         for has, prop in LEGACY_EDGE_LAYERS:
             if getattr(me, has):
                 d.edge_data[prop] = _get(me.edges, prop, ne, np.float32)
+    # The edges' vertex pairs key the edge data for writing back: read only when there is some.
+    if not d.edge_data:
+        d.edges = np.zeros((0, 2), np.int32)
+    elif ".edge_verts" in builtin:
+        d.edges = _builtin(me, ".edge_verts", ne, np.int32, 0, 2)
+    else:
+        d.edges = _get(me.edges, "vertices", ne, np.int32, 2)
     if me.has_custom_normals:
         d.not_carried.append("custom split normals")
     d.soup = {"positions": positions, "face_sizes": loop_total, "corners": corners, "channels": channels}
@@ -481,32 +526,29 @@ def _write_attributes(me, data, result, create, loop_inverse=None):
             me.color_attributes.render_color_index = me.color_attributes.find(data.render_color)
 
     for name, domain, collection, prop, dtype in (
-            ("material", "face", me.polygons, "material_index", np.int32),
-            ("smooth", "face", me.polygons, "use_smooth", np.bool_),
-            ("selected", "vertex", me.vertices, "select", np.bool_),
-            ("selected", "face", me.polygons, "select", np.bool_),
-            ("hidden", "vertex", me.vertices, "hide", np.bool_),
-            ("hidden", "face", me.polygons, "hide", np.bool_),
-            ("bevel_weight", "vertex", me.vertices, "bevel_weight", np.float32)):
+            ("material", "face", "polygons", "material_index", np.int32),
+            ("smooth", "face", "polygons", "use_smooth", np.bool_),
+            ("selected", "vertex", "vertices", "select", np.bool_),
+            ("selected", "face", "polygons", "select", np.bool_),
+            ("hidden", "vertex", "vertices", "hide", np.bool_),
+            ("hidden", "face", "polygons", "hide", np.bool_),
+            ("bevel_weight", "vertex", "vertices", "bevel_weight", np.float32)):
         values = channel(soup, name, domain)
         if values is None:
             continue
         values = values.view(dtype) if dtype == np.bool_ else values.astype(dtype, copy=False)
         if create and np.array_equal(_fresh_values(me, collection, prop, dtype), values):
             continue  # what new geometry holds already (zeros, False; smooth faces from 4.1 on)
-        _set(collection, prop, values)
+        _set(getattr(me, collection), prop, values)
 
 
 def _fresh_values(me, collection, prop, dtype):
-    """What a property of new geometry holds. 4.0+ keeps smooth shading, selection, hiding and
-    materials as attributes, absent on new geometry (so every value is the default): only
-    "sharp_face", which some versions add to new faces, is read."""
-    n = len(collection)
-    if BUILTIN_ATTRIBUTES and prop in ("material_index", "select", "hide"):
-        return np.zeros(n, dtype)
-    if BUILTIN_ATTRIBUTES and prop == "use_smooth":
+    """What a property of new geometry holds, read the fast way where Blender keeps it as an
+    attribute (new geometry has none of them but, in some versions, "sharp_face")."""
+    n = len(getattr(me, collection))
+    if prop == "use_smooth" and (collection, prop) in builtin_attributes():
         return ~_builtin(me, "sharp_face", n, np.bool_, False)
-    return _get(collection, prop, n, dtype)
+    return _flag(me, collection, prop, n, dtype)
 
 
 def _write_edges(me, data, result):
@@ -578,7 +620,7 @@ def write_mesh(me, data, result, rebuild=False, obj=None):
     me.loops.add(nc)
     me.polygons.add(nf)
     _set(me.vertices, "co", positions)
-    corner_vert = me.attributes.get(".corner_vert") if BUILTIN_ATTRIBUTES else None
+    corner_vert = me.attributes.get(".corner_vert") if ".corner_vert" in builtin_attributes() else None
     if corner_vert is not None:
         _set(corner_vert.data, "value", corners)
     else:
