@@ -380,14 +380,8 @@ Mesh split_step(const Mesh& m, SubdivisionScheme scheme, const std::vector<bool>
       }
     });
   });
-  if (edge_props)
-    copy_parents(m.edge_properties(), out.edge_properties(), E, emap, E2);
-  else
-    out.edge_properties().resize(E2);
-  if (face_props)
-    copy_parents(m.face_properties(), out.face_properties(), F, fmap, F2);
-  else
-    out.face_properties().resize(F2);
+  copy_parents(m.edge_properties(), out.edge_properties(), E, emap, E2);  // no properties: only sized
+  copy_parents(m.face_properties(), out.face_properties(), F, fmap, F2);
   return out;
 }
 

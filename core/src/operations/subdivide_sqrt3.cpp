@@ -367,14 +367,8 @@ Mesh sqrt3_step(const Mesh& m, bool trisect, std::vector<bool>& crease, unsigned
           blend_cut(Mesh::halfedge(cut_creases[c], side), crease_slot0 + 4 * c + 2 * side);
     });
   });
-  if (edge_props)
-    copy_parents(m.edge_properties(), out.edge_properties(), E, emap, E2);
-  else
-    out.edge_properties().resize(E2);
-  if (face_props)
-    copy_parents(m.face_properties(), out.face_properties(), F, fmap, F2);
-  else
-    out.face_properties().resize(F2);
+  copy_parents(m.edge_properties(), out.edge_properties(), E, emap, E2);  // no properties: only sized
+  copy_parents(m.face_properties(), out.face_properties(), F, fmap, F2);
   if (creases) {
     // The old edges keep their flags (interior ones were flipped only if smooth); a cut
     // crease's two new pieces are creases, the spokes are not.
