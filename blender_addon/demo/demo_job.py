@@ -15,6 +15,7 @@ import time
 import bpy
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tools"))
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import hedge_install  # noqa: E402
 
 argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
@@ -105,55 +106,9 @@ with open(os.path.join(args.out, "blender_demo.json"), "w") as f:
 if args.no_render:
     sys.exit(0)
 
-# The picture: before (left) and after (right), Workbench, flat shading shows the facets.
-from mathutils import Vector  # noqa: E402
-scale = 1.15 / max(before.dimensions)
-for obj, x in ((before, -0.6), (dragon, 0.6)):
-    obj.data.polygons.foreach_set("use_smooth", [False] * len(obj.data.polygons))
-    obj.rotation_euler = (1.5708, 0, 0.5)
-    obj.location = (0, 0, 0)
-    obj.scale = (scale, scale, scale)
-    bpy.context.view_layer.update()
-    centre = sum((obj.matrix_world @ Vector(c) for c in obj.bound_box), Vector()) / 8
-    obj.location = Vector((x, 0, 0)) - centre
-for text, x, n in (("before", -0.6, faces(before)), ("after", 0.6, faces(dragon))):
-    curve = bpy.data.curves.new(text, 'FONT')
-    curve.body = f"{text}: {n:,} faces"
-    curve.size = 0.07
-    curve.align_x = 'CENTER'
-    label = bpy.data.objects.new(text + " label", curve)
-    label.location = (x, 0, -0.5)
-    label.rotation_euler = (1.5708, 0, 0)
-    bpy.context.collection.objects.link(label)
-cam_data = bpy.data.cameras.new("camera")
-cam_data.type = 'ORTHO'
-cam_data.ortho_scale = 2.5
-camera = bpy.data.objects.new("camera", cam_data)
-camera.location = (0, -4, 0)
-camera.rotation_euler = (1.5708, 0, 0)
-bpy.context.collection.objects.link(camera)
-scene = bpy.context.scene
-scene.camera = camera
-scene.render.engine = 'BLENDER_WORKBENCH'
-scene.display.shading.light = 'STUDIO'
-scene.display.shading.color_type = 'SINGLE'
-scene.display.shading.single_color = (0.8, 0.55, 0.3)
-scene.display.shading.show_cavity = True
-scene.render.resolution_x = 1400
-scene.render.resolution_y = 700
-scene.render.resolution_percentage = 100
-scene.render.film_transparent = False
-scene.world = bpy.data.worlds.new("world") if scene.world is None else scene.world
-scene.world.color = (1, 1, 1)
-scene.view_settings.view_transform = 'Standard'  # a white background (4.x's default AgX greys it)
-scene.render.image_settings.file_format = 'PNG'
-scene.render.filepath = os.path.join(args.out, "blender_before_after.png")
-_, t = timed("render", lambda: bpy.ops.render.render(write_still=True))
-print(f"  rendered {scene.render.filepath} ({t:.1f} s)")
-if args.picture:
-    image = bpy.data.images.load(scene.render.filepath)
-    image.scale(700, 350)
-    image.filepath_raw = os.path.abspath(args.picture)
-    image.file_format = 'PNG'
-    image.save()
-    print(f"  small copy {args.picture} ({os.path.getsize(args.picture) // 1024} KB)")
+# The picture: before (left) and after (right).
+from picture import render_before_after  # noqa: E402
+_, t = timed("render", lambda: render_before_after(
+    before, dragon, (f"before: {faces(before):,} faces", f"after: {faces(dragon):,} faces"),
+    os.path.join(args.out, "blender_before_after.png"), args.picture, color=(0.8, 0.55, 0.3)))
+print(f"  render took {t:.1f} s")

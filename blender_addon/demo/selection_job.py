@@ -10,10 +10,11 @@ import sys
 
 import bmesh
 import bpy
-from mathutils import Vector
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tools"))
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import hedge_install  # noqa: E402
+from picture import render_before_after  # noqa: E402
 
 argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
 parser = argparse.ArgumentParser()
@@ -73,52 +74,6 @@ selected_after = sum(p.select for p in me.polygons)
 print(f"  selection-only decimate to {args.ratio:.0%}: {faces_before:,} -> {len(me.polygons):,} faces; "
       f"selected {selected_before:,} -> {selected_after:,}, the other {faces_before - selected_before:,} kept")
 
-scale = 1.15 / max(before.dimensions)
-for obj, x in ((before, -0.6), (dragon, 0.6)):
-    obj.data.polygons.foreach_set("use_smooth", [False] * len(obj.data.polygons))
-    obj.rotation_euler = (1.5708, 0, 0.5)
-    obj.location = (0, 0, 0)
-    obj.scale = (scale, scale, scale)
-    bpy.context.view_layer.update()
-    centre = sum((obj.matrix_world @ Vector(c) for c in obj.bound_box), Vector()) / 8
-    obj.location = Vector((x, 0, 0)) - centre
-for text, x, n, s in (("before", -0.6, faces_before, selected_before),
-                      ("after", 0.6, len(me.polygons), selected_after)):
-    curve = bpy.data.curves.new(text, 'FONT')
-    curve.body = f"{text}: {n:,} faces, {s:,} selected"
-    curve.size = 0.06
-    curve.align_x = 'CENTER'
-    label = bpy.data.objects.new(text + " label", curve)
-    label.location = (x, 0, -0.5)
-    label.rotation_euler = (1.5708, 0, 0)
-    bpy.context.collection.objects.link(label)
-camera_data = bpy.data.cameras.new("camera")
-camera_data.type = 'ORTHO'
-camera_data.ortho_scale = 2.5
-camera = bpy.data.objects.new("camera", camera_data)
-camera.location = (0, -4, 0)
-camera.rotation_euler = (1.5708, 0, 0)
-bpy.context.collection.objects.link(camera)
-scene = bpy.context.scene
-scene.camera = camera
-scene.render.engine = 'BLENDER_WORKBENCH'
-scene.display.shading.light = 'STUDIO'
-scene.display.shading.color_type = 'MATERIAL'
-scene.display.shading.show_cavity = True
-scene.render.resolution_x = 1400
-scene.render.resolution_y = 700
-scene.render.resolution_percentage = 100
-scene.world = bpy.data.worlds.new("world") if scene.world is None else scene.world
-scene.world.color = (1, 1, 1)
-scene.view_settings.view_transform = 'Standard'
-scene.render.image_settings.file_format = 'PNG'
-scene.render.filepath = os.path.join(args.out, "blender_selection.png")
-bpy.ops.render.render(write_still=True)
-print(f"  rendered {scene.render.filepath}")
-if args.picture:
-    image = bpy.data.images.load(scene.render.filepath)
-    image.scale(700, 350)
-    image.filepath_raw = os.path.abspath(args.picture)
-    image.file_format = 'PNG'
-    image.save()
-    print(f"  small copy {args.picture} ({os.path.getsize(args.picture) // 1024} KB)")
+render_before_after(before, dragon, (f"before: {faces_before:,} faces, {selected_before:,} selected",
+                                     f"after: {len(me.polygons):,} faces, {selected_after:,} selected"),
+                    os.path.join(args.out, "blender_selection.png"), args.picture, label_size=0.06)

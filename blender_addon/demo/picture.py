@@ -1,0 +1,65 @@
+# The demos' before/after picture: two objects side by side under an orthographic camera, each
+# with a label, rendered with Workbench (flat shading shows the facets), and a small copy for
+# the README.
+import os
+
+import bpy
+from mathutils import Vector
+
+
+def render_before_after(before, after, labels, path, picture="", color=None, label_size=0.07):
+    """Renders `before` (left) and `after` (right) into `path`; `labels` are their captions.
+    `color`: one RGB for both, or None to draw each face in its material's colour."""
+    scale = 1.15 / max(before.dimensions)
+    for obj, x in ((before, -0.6), (after, 0.6)):
+        obj.data.polygons.foreach_set("use_smooth", [False] * len(obj.data.polygons))
+        obj.rotation_euler = (1.5708, 0, 0.5)
+        obj.location = (0, 0, 0)
+        obj.scale = (scale, scale, scale)
+        bpy.context.view_layer.update()
+        centre = sum((obj.matrix_world @ Vector(c) for c in obj.bound_box), Vector()) / 8
+        obj.location = Vector((x, 0, 0)) - centre
+    for text, x in zip(labels, (-0.6, 0.6)):
+        curve = bpy.data.curves.new("label", 'FONT')
+        curve.body = text
+        curve.size = label_size
+        curve.align_x = 'CENTER'
+        label = bpy.data.objects.new("label", curve)
+        label.location = (x, 0, -0.5)
+        label.rotation_euler = (1.5708, 0, 0)
+        bpy.context.collection.objects.link(label)
+    camera_data = bpy.data.cameras.new("camera")
+    camera_data.type = 'ORTHO'
+    camera_data.ortho_scale = 2.5
+    camera = bpy.data.objects.new("camera", camera_data)
+    camera.location = (0, -4, 0)
+    camera.rotation_euler = (1.5708, 0, 0)
+    bpy.context.collection.objects.link(camera)
+    scene = bpy.context.scene
+    scene.camera = camera
+    scene.render.engine = 'BLENDER_WORKBENCH'
+    scene.display.shading.light = 'STUDIO'
+    if color is None:
+        scene.display.shading.color_type = 'MATERIAL'
+    else:
+        scene.display.shading.color_type = 'SINGLE'
+        scene.display.shading.single_color = color
+    scene.display.shading.show_cavity = True
+    scene.render.resolution_x = 1400
+    scene.render.resolution_y = 700
+    scene.render.resolution_percentage = 100
+    scene.render.film_transparent = False
+    scene.world = bpy.data.worlds.new("world") if scene.world is None else scene.world
+    scene.world.color = (1, 1, 1)
+    scene.view_settings.view_transform = 'Standard'  # a white background (4.x's default AgX greys it)
+    scene.render.image_settings.file_format = 'PNG'
+    scene.render.filepath = path
+    bpy.ops.render.render(write_still=True)
+    print(f"  rendered {path}")
+    if picture:
+        image = bpy.data.images.load(path)
+        image.scale(700, 350)
+        image.filepath_raw = os.path.abspath(picture)
+        image.file_format = 'PNG'
+        image.save()
+        print(f"  small copy {picture} ({os.path.getsize(picture) // 1024} KB)")
