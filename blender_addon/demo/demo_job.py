@@ -6,7 +6,6 @@
 #       --mesh dragon.ply --out DIR [--zip PACKAGE] [--picture docs/blender_demo.png] [--no-modifier] [--no-render]
 # --zip: installed first when hedge is not installed yet: the legacy add-on zip for Blender
 # 3.4-4.1, the extension zip (build/hedge_blender_extension.zip) for 4.2 and later.
-import argparse
 import json
 import os
 import sys
@@ -14,31 +13,17 @@ import time
 
 import bpy
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tools"))
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import hedge_install  # noqa: E402
+from demo_common import arguments, load_hedge, render_before_after  # noqa: E402
 
-argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
-parser = argparse.ArgumentParser()
-parser.add_argument("--mesh", required=True)
-parser.add_argument("--out", required=True)
-parser.add_argument("--picture", default="", help="also write a small copy of the picture here")
-parser.add_argument("--no-modifier", action="store_true", help="skip Blender's Decimate modifier")
-parser.add_argument("--no-render", action="store_true")
-parser.add_argument("--zip", default="", help="install this package first if hedge is not installed")
-args = parser.parse_args(argv)
-os.makedirs(args.out, exist_ok=True)
 
-try:
-    hedge_install.enable(quiet=True)
-except RuntimeError:
-    if not args.zip:
-        sys.exit("the hedge add-on is not installed (./run install, or pass --zip)")
-    hedge_install.install(args.zip)
-import hedge  # noqa: E402
+def options(parser):
+    parser.add_argument("--no-modifier", action="store_true", help="skip Blender's Decimate modifier")
+    parser.add_argument("--no-render", action="store_true")
 
-for obj in list(bpy.data.objects):
-    bpy.data.objects.remove(obj)
+
+args = arguments(options)
+hedge = load_hedge(args.zip)
 
 
 def faces(obj):
@@ -107,7 +92,6 @@ if args.no_render:
     sys.exit(0)
 
 # The picture: before (left) and after (right).
-from picture import render_before_after  # noqa: E402
 _, t = timed("render", lambda: render_before_after(
     before, dragon, (f"before: {faces(before):,} faces", f"after: {faces(dragon):,} faces"),
     os.path.join(args.out, "blender_before_after.png"), args.picture, color=(0.8, 0.55, 0.3)))

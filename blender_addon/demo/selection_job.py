@@ -4,38 +4,22 @@
 # before/after picture with Workbench (flat shading shows the facets).
 #   xvfb-run -a blender -b --factory-startup --python-exit-code 1 --python selection_job.py -- \
 #       --mesh dragon_res2.ply --out DIR [--zip PACKAGE] [--picture docs/blender_selection.png]
-import argparse
 import os
 import sys
 
 import bmesh
 import bpy
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tools"))
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import hedge_install  # noqa: E402
-from picture import render_before_after  # noqa: E402
+from demo_common import arguments, load_hedge, render_before_after  # noqa: E402
 
-argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
-parser = argparse.ArgumentParser()
-parser.add_argument("--mesh", required=True)
-parser.add_argument("--out", required=True)
-parser.add_argument("--ratio", type=float, default=0.05)
-parser.add_argument("--picture", default="", help="also write a small copy of the picture here")
-parser.add_argument("--zip", default="", help="install this package first if hedge is not installed")
-args = parser.parse_args(argv)
-os.makedirs(args.out, exist_ok=True)
 
-try:
-    hedge_install.enable(quiet=True)
-except RuntimeError:
-    if not args.zip:
-        sys.exit("the hedge add-on is not installed (./run install, or pass --zip)")
-    hedge_install.install(args.zip)
-import hedge  # noqa: E402
+def options(parser):
+    parser.add_argument("--ratio", type=float, default=0.05)
 
-for obj in list(bpy.data.objects):
-    bpy.data.objects.remove(obj)
+
+args = arguments(options)
+hedge = load_hedge(args.zip)
 
 dragon = hedge.api.import_file(args.mesh, "dragon")
 me = dragon.data

@@ -1,10 +1,44 @@
-# The demos' before/after picture: two objects side by side under an orthographic camera, each
-# with a label, rendered with Workbench (flat shading shows the facets), and a small copy for
-# the README.
+# What the Blender demo jobs share: their command line, loading hedge, and the before/after
+# picture (two objects side by side under an orthographic camera, each with a label, rendered
+# with Workbench, whose flat shading shows the facets, and a small copy for the README).
+import argparse
 import os
+import sys
 
 import bpy
 from mathutils import Vector
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tools"))
+import hedge_install  # noqa: E402
+
+
+def arguments(add_options):
+    """The job's arguments after `--`: --mesh, --out, --picture, --zip, and what
+    add_options(parser) adds. Makes --out."""
+    argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--mesh", required=True)
+    parser.add_argument("--out", required=True)
+    parser.add_argument("--picture", default="", help="also write a small copy of the picture here")
+    parser.add_argument("--zip", default="", help="install this package first if hedge is not installed")
+    add_options(parser)
+    args = parser.parse_args(argv)
+    os.makedirs(args.out, exist_ok=True)
+    return args
+
+
+def load_hedge(zip_path):
+    """The hedge package, enabled, or installed from `zip_path` first; an empty scene."""
+    try:
+        hedge_install.enable(quiet=True)
+    except RuntimeError:
+        if not zip_path:
+            sys.exit("the hedge add-on is not installed (./run install, or pass --zip)")
+        hedge_install.install(zip_path)
+    import hedge
+    for obj in list(bpy.data.objects):
+        bpy.data.objects.remove(obj)
+    return hedge
 
 
 def render_before_after(before, after, labels, path, picture="", color=None, label_size=0.07):
