@@ -234,6 +234,25 @@ void refine_corners(const Mesh& m, Mesh& out, std::size_t extra, const std::vect
   out.halfedge_properties() = std::move(props);
 }
 
+//! The mesh a step writes (V2 vertices, E2 edges, F2 faces, every field still unset) and
+//! its maps back to the input: a new half-edge's corner slot (refine_corners), a new edge's
+//! old edge, a child face's parent. A map is empty when the input has no properties of its kind.
+struct StepOutput {
+  Mesh out;
+  bool corner_props, edge_props, face_props;
+  std::vector<Index> hmap, emap, fmap;
+
+  StepOutput(const Mesh& m, Index V2, Index E2, Index F2)
+      : corner_props(m.halfedge_properties().count() > 0),
+        edge_props(m.edge_properties().count() > 0),
+        face_props(m.face_properties().count() > 0),
+        hmap(corner_props ? std::size_t(2) * E2 : 0),
+        emap(edge_props ? E2 : 0),
+        fmap(face_props ? F2 : 0) {
+    out.resize(V2, E2, F2);
+  }
+};
+
 //! Edge or face properties of a step: each new element copies its parent's (`map`), slot
 //! `default_slot` the defaults; `size` new elements when there are no properties.
 void copy_parents(PropertyContainer from, PropertyContainer& to, std::size_t default_slot,

@@ -216,13 +216,10 @@ Mesh split_step(const Mesh& m, SubdivisionScheme scheme, const std::vector<bool>
   const Index FP = Index(plan.face_of_point.size());
   const Index V2 = V + E + FP, E2 = 2 * E + plan.inner_edges, F2 = plan.child_faces;
 
-  Mesh out;
-  out.resize(V2, E2, F2);
-  const bool corner_props = m.halfedge_properties().count() > 0;
-  const bool edge_props = m.edge_properties().count() > 0;
-  const bool face_props = m.face_properties().count() > 0;
-  // New half-edge -> corner slot (see refine_corners), new edge -> old edge, child -> parent face.
-  std::vector<Index> hmap(corner_props ? std::size_t(2) * E2 : 0), emap(edge_props ? E2 : 0), fmap(face_props ? F2 : 0);
+  StepOutput step(m, V2, E2, F2);
+  Mesh& out = step.out;
+  const bool corner_props = step.corner_props, edge_props = step.edge_props, face_props = step.face_props;
+  std::vector<Index>&hmap = step.hmap, &emap = step.emap, &fmap = step.fmap;
   const Index centroid_slot = 2 * H, default_corner = 2 * H + FP;
 
   // Faces: the halves of their half-edges, the interior edges and the child faces.
@@ -382,7 +379,7 @@ Mesh split_step(const Mesh& m, SubdivisionScheme scheme, const std::vector<bool>
   });
   copy_parents(m.edge_properties(), out.edge_properties(), E, emap, E2);  // no properties: only sized
   copy_parents(m.face_properties(), out.face_properties(), F, fmap, F2);
-  return out;
+  return std::move(out);  // a reference into step: moved, not copied
 }
 
 }  // namespace hedge::subdivision

@@ -96,12 +96,10 @@ Mesh sqrt3_step(const Mesh& m, bool trisect, std::vector<bool>& crease, unsigned
     }
   });
 
-  Mesh out;
-  out.resize(V2, E2, F2);
-  const bool corner_props = m.halfedge_properties().count() > 0;
-  const bool edge_props = m.edge_properties().count() > 0;
-  const bool face_props = m.face_properties().count() > 0;
-  std::vector<Index> hmap(corner_props ? std::size_t(2) * E2 : 0), emap(edge_props ? E2 : 0), fmap(face_props ? F2 : 0);
+  StepOutput step(m, V2, E2, F2);
+  Mesh& out = step.out;
+  const bool corner_props = step.corner_props, edge_props = step.edge_props, face_props = step.face_props;
+  std::vector<Index>&hmap = step.hmap, &emap = step.emap, &fmap = step.fmap;
 
   // Spoke (f, i) joins face point P_f and corner c_i; side 0 runs P_f -> c_i. The old inner
   // half-edge h = h_i of f (pointing to c_i) keeps its index: when its edge is interior it
@@ -377,7 +375,7 @@ Mesh sqrt3_step(const Mesh& m, bool trisect, std::vector<bool>& crease, unsigned
     for (std::size_t c = 0; c < C; ++c) next[crease_edge0 + 6 * c] = next[crease_edge0 + 6 * c + 1] = true;
     crease = std::move(next);
   }
-  return out;
+  return std::move(out);  // a reference into step: moved, not copied
 }
 
 }  // namespace hedge::subdivision
