@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <initializer_list>
 #include <numbers>
 #include <span>
 #include <utility>
@@ -252,6 +253,16 @@ struct StepOutput {
     out.resize(V2, E2, F2);
   }
 };
+
+//! Makes `loop` (half-edges in order) the loop of face t: each one's next and face.
+inline void link_loop(Mesh& out, Face t, std::initializer_list<Halfedge> loop) {
+  const Halfedge* h = loop.begin();
+  const std::size_t n = loop.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    out.set_next(h[i], h[i + 1 == n ? 0 : i + 1]);
+    out.set_face(h[i], t);
+  }
+}
 
 //! Edge or face properties of a step: each new element copies its parent's (`map`), slot
 //! `default_slot` the defaults; `size` new elements when there are no properties.

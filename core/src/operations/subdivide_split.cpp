@@ -244,12 +244,7 @@ Mesh split_step(const Mesh& m, SubdivisionScheme scheme, const std::vector<bool>
         const Index j = i == 2 ? 0 : i + 1;
         const Halfedge a = second_half(h[i]), b = first_half(h[j]), c = inner(i, 0), d = inner(i, 1);
         const Face t(ff + i);
-        out.set_next(a, b);
-        out.set_next(b, c);
-        out.set_next(c, a);
-        out.set_face(a, t);
-        out.set_face(b, t);
-        out.set_face(c, t);
+        link_loop(out, t, {a, b, c});
         out.set_halfedge(t, a);
         out.set_vertex(c, Vertex(V + Mesh::edge(h[i]).idx()));
         out.set_vertex(d, Vertex(V + Mesh::edge(h[j]).idx()));
@@ -270,14 +265,7 @@ Mesh split_step(const Mesh& m, SubdivisionScheme scheme, const std::vector<bool>
       for (Index i = 0; i < n; ++i) {
         const Halfedge a = second_half(h[i]), b = first_half(h[(i + 1) % n]), c = inner(i + 1, 1), d = inner(i, 0);
         const Face t(ff + i);
-        out.set_next(a, b);
-        out.set_next(b, c);
-        out.set_next(c, d);
-        out.set_next(d, a);
-        out.set_face(a, t);
-        out.set_face(b, t);
-        out.set_face(c, t);
-        out.set_face(d, t);
+        link_loop(out, t, {a, b, c, d});
         out.set_halfedge(t, a);
         out.set_vertex(d, Vertex(V + Mesh::edge(h[i]).idx()));
         out.set_vertex(inner(i, 1), fp);

@@ -131,10 +131,7 @@ Mesh sqrt3_step(const Mesh& m, bool trisect, std::vector<bool>& crease, unsigned
         {c.first, c.x, to_a}, {c.mid, c.y, Mesh::opposite(c.x)}, {c.last, a, Mesh::opposite(c.y)}};
     const Face faces[3] = {Face(3 * f + i), c.t1, c.t2};
     for (int j = 0; j < 3; ++j) {
-      for (int l = 0; l < 3; ++l) {
-        out.set_next(loops[j][l], loops[j][(l + 1) % 3]);
-        out.set_face(loops[j][l], faces[j]);
-      }
+      link_loop(out, faces[j], {loops[j][0], loops[j][1], loops[j][2]});
       out.set_halfedge(faces[j], loops[j][0]);
       if (face_props) fmap[faces[j].idx()] = f;
     }
@@ -226,12 +223,7 @@ Mesh sqrt3_step(const Mesh& m, bool trisect, std::vector<bool>& crease, unsigned
           }
         }
         // a: c_i -> P_f, then b, then c back to a's origin.
-        out.set_next(a, b);
-        out.set_next(b, c);
-        out.set_next(c, a);
-        out.set_face(a, t);
-        out.set_face(b, t);
-        out.set_face(c, t);
+        link_loop(out, t, {a, b, c});
         if (corner_props) hmap[a.idx()] = H + f;
         if (face_props) fmap[t.idx()] = f;
         if (edge_props) emap[E + 3 * f + i] = E;
