@@ -126,8 +126,9 @@ TEST(Selection, EveryOperationWithItKeepsTheUnselectedFaces) {
       EXPECT_EQ(faces_where(r.soup, false), faces_where(*input, false));
       EXPECT_EQ(open_unselected_edges(r.soup), open_unselected_edges(*input));
       // (fill_holes: no hole of the bunny lies inside the left half; see the test below)
-      if (op->id != "fill_holes")
+      if (op->id != "fill_holes") {
         EXPECT_NE(faces_where(r.soup, true), faces_where(*input, true)) << "nothing changed inside the selection";
+      }
       EXPECT_TRUE(r.report.messages.empty() ||
                   std::find(r.report.messages.begin(), r.report.messages.end(),
                             "selection_only: nothing is selected, so the mesh is unchanged") ==
@@ -234,7 +235,9 @@ TEST(Selection, SmoothMovesOnlyTheSelectedVertices) {
   std::size_t moved = 0;
   for (std::size_t v = 0; v < bunny.n_vertices(); ++v) {
     const bool same = r.soup.positions[v] == bunny.positions[v];
-    if (!selected[v]) EXPECT_TRUE(same) << "unselected vertex " << v << " moved";
+    if (!selected[v]) {
+      EXPECT_TRUE(same) << "unselected vertex " << v << " moved";
+    }
     moved += !same;
   }
   EXPECT_GT(moved, bunny.n_vertices() / 4);
