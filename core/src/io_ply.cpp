@@ -1,6 +1,7 @@
 // PLY files (Stanford polygon format) in ASCII, binary little endian and binary big endian:
 // positions, faces with any list types, vertex normals/colours/quality/uv, face colours/
-// quality/material, per-corner uv (MeshLab's texcoord list); anything else is skipped.
+// quality/material, per-corner uv (MeshLab's texcoord list), and a vertex or face "selected"
+// (any scalar, non-zero when selected; hedge's own convention); anything else is skipped.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -79,7 +80,7 @@ const char* type_name(PlyType t) {
   return "?";
 }
 
-enum class Target : std::uint8_t { skip, position, normal, color, quality, uv, indices, texcoord, material };
+enum class Target : std::uint8_t { skip, position, normal, color, quality, uv, indices, texcoord, material, selected };
 
 struct PlyProperty {
   std::string name;
@@ -242,6 +243,7 @@ void assign_targets(Header& header, const std::string& name) {
       else if (PlyProperty* c = scalar("confidence"))
         c->target = Target::quality;
       group({"texture_u", "texture_v"}, Target::uv) || group({"u", "v"}, Target::uv) || group({"s", "t"}, Target::uv);
+      if (PlyProperty* s = scalar("selected")) s->target = Target::selected;
     } else if (e.name == "face") {
       if (have_face) fail("a second element 'face'");
       have_face = true;
@@ -257,6 +259,7 @@ void assign_targets(Header& header, const std::string& name) {
       if (PlyProperty* q = scalar("quality")) q->target = Target::quality;
       if (PlyProperty* m = scalar("material_index")) m->target = Target::material;
       if (PlyProperty* t = e.find("texcoord"); t && t->list) t->target = Target::texcoord;
+      if (PlyProperty* s = scalar("selected")) s->target = Target::selected;
     }
   }
 }
@@ -284,10 +287,11 @@ struct Sink {
   explicit Sink(Soup& s) : soup(s) {}
   Soup& soup;
   std::vector<float> normals, vertex_quality, vertex_uv, face_quality, corner_uv, texcoord;
-  std::vector<std::uint8_t> vertex_color, face_color;
+  std::vector<std::uint8_t> vertex_color, face_color, vertex_selected, face_selected;
   std::vector<std::int32_t> material;
   bool has_normal = false, has_vertex_color = false, has_vertex_quality = false, has_vertex_uv = false;
   bool has_face_color = false, has_face_quality = false, has_material = false, has_texcoord = false;
+  bool has_vertex_selected = false, has_face_selected = false;
 };
 
 //! Context for error messages: which element, instance and property is being read.
@@ -506,6 +510,9 @@ void read_body(Source& in, Header& header, Place& place, Sink& sink) {
             case Target::uv:
               sink.vertex_uv[2 * i + k] = static_cast<float>(v);
               break;
+            case Target::selected:
+              sink.vertex_selected[i] = v != 0;
+              break;
             default:
               break;
           }
@@ -519,6 +526,9 @@ void read_body(Source& in, Header& header, Place& place, Sink& sink) {
               break;
             case Target::material:
               sink.material[i] = static_cast<std::int32_t>(std::clamp(v, -2147483648.0, 2147483647.0));
+              break;
+            case Target::selected:
+              sink.face_selected[i] = v != 0;
               break;
             default:
               break;
@@ -562,11 +572,13 @@ Soup read_ply(const std::string& bytes, const std::string& name) {
         sink.has_vertex_color |= p.target == Target::color;
         sink.has_vertex_quality |= p.target == Target::quality;
         sink.has_vertex_uv |= p.target == Target::uv;
+        sink.has_vertex_selected |= p.target == Target::selected;
       } else if (e.kind == Kind::face) {
         sink.has_face_color |= p.target == Target::color;
         sink.has_face_quality |= p.target == Target::quality;
         sink.has_material |= p.target == Target::material;
         sink.has_texcoord |= p.target == Target::texcoord;
+        sink.has_face_selected |= p.target == Target::selected;
       }
     }
     if (e.kind == Kind::vertex) nv = e.count;
@@ -581,6 +593,8 @@ Soup read_ply(const std::string& bytes, const std::string& name) {
   if (sink.has_face_color) sink.face_color.resize(4 * nf, 255);
   if (sink.has_face_quality) sink.face_quality.resize(nf);
   if (sink.has_material) sink.material.resize(nf);
+  if (sink.has_vertex_selected) sink.vertex_selected.resize(nv);
+  if (sink.has_face_selected) sink.face_selected.resize(nf);
   soup.face_sizes.reserve(nf);
   std::size_t index_bytes = 2;
   for (const PlyElement& e : header.elements)
@@ -620,6 +634,8 @@ Soup read_ply(const std::string& bytes, const std::string& name) {
   if (sink.has_face_quality) add("quality", Domain::face, ScalarType::f32, 1, sink.face_quality);
   if (sink.has_material) add("material", Domain::face, ScalarType::i32, 1, sink.material);
   if (sink.has_texcoord) add("uv", Domain::corner, ScalarType::f32, 2, sink.corner_uv);
+  if (sink.has_vertex_selected) add("selected", Domain::vertex, ScalarType::u8, 1, sink.vertex_selected);
+  if (sink.has_face_selected) add("selected", Domain::face, ScalarType::u8, 1, sink.face_selected);
   check_soup(soup, name);
   return soup;
 }
@@ -667,6 +683,8 @@ std::string write_ply(const Soup& soup, bool binary) {
   const Channel* face_quality = find_channel(soup, "quality", Domain::face, ScalarType::f32, 1);
   const Channel* material = find_channel(soup, "material", Domain::face, ScalarType::i32, 1);
   const Channel* corner_uvs = find_channel(soup, "uv", Domain::corner, ScalarType::f32, 2);
+  const Channel* selected = find_channel(soup, "selected", Domain::vertex, ScalarType::u8, 1);
+  const Channel* face_selected = find_channel(soup, "selected", Domain::face, ScalarType::u8, 1);
 
   std::uint32_t max_size = 0;
   for (std::uint32_t s : soup.face_sizes) max_size = std::max(max_size, s);
@@ -683,6 +701,7 @@ std::string write_ply(const Soup& soup, bool binary) {
   if (colors) out += "property uchar red\nproperty uchar green\nproperty uchar blue\nproperty uchar alpha\n";
   if (quality) out += "property float quality\n";
   if (uvs) out += "property float texture_u\nproperty float texture_v\n";
+  if (selected) out += "property uchar selected\n";
   out += "element face " + std::to_string(soup.n_faces()) + "\n";
   out += std::string("property list ") + (small_faces ? "uchar" : "uint") + (signed_indices ? " int" : " uint") +
          " vertex_indices\n";
@@ -690,6 +709,7 @@ std::string write_ply(const Soup& soup, bool binary) {
   if (face_colors) out += "property uchar red\nproperty uchar green\nproperty uchar blue\nproperty uchar alpha\n";
   if (face_quality) out += "property float quality\n";
   if (material) out += "property int material_index\n";
+  if (face_selected) out += "property uchar selected\n";
   out += "end_header\n";
   out.reserve(out.size() + soup.n_vertices() * (binary ? 12 : 30) + soup.n_corners() * (binary ? 4 : 8) +
               soup.n_faces() * 2);
@@ -704,6 +724,7 @@ std::string write_ply(const Soup& soup, bool binary) {
     if (quality) w.value(quality->as<float>()[v]);
     if (uvs)
       for (int k = 0; k < 2; ++k) w.value(uvs->as<float>()[2 * v + k]);
+    if (selected) w.value(selected->as<std::uint8_t>()[v]);
     w.end_element();
   }
   std::size_t corner = 0;
@@ -730,6 +751,7 @@ std::string write_ply(const Soup& soup, bool binary) {
       for (std::uint8_t c : face_colors[f]) w.value(c);
     if (face_quality) w.value(face_quality->as<float>()[f]);
     if (material) w.value(material->as<std::int32_t>()[f]);
+    if (face_selected) w.value(face_selected->as<std::uint8_t>()[f]);
     w.end_element();
     corner += size;
   }

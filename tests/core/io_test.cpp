@@ -599,6 +599,11 @@ Soup soup_with_all_ply_channels() {
   soup.channels.push_back(make_channel("quality", Domain::face, ScalarType::f32, 1, face_quality));
   soup.channels.push_back(make_channel("material", Domain::face, ScalarType::i32, 1, material));
   soup.channels.push_back(make_channel("uv", Domain::corner, ScalarType::f32, 2, corner_uv));
+  std::vector<std::uint8_t> selected(nv), face_selected(nf);
+  for (std::size_t i = 0; i < nv; ++i) selected[i] = i % 2;
+  for (std::size_t i = 0; i < nf; ++i) face_selected[i] = (i + 1) % 2;
+  soup.channels.push_back(make_channel("selected", Domain::vertex, ScalarType::u8, 1, selected));
+  soup.channels.push_back(make_channel("selected", Domain::face, ScalarType::u8, 1, face_selected));
   soup.check();
   return soup;
 }
