@@ -130,9 +130,11 @@ def _builtin(me, name, n, dtype, default, components=1):
 
 
 def _flag(me, collection, prop, n, dtype):
-    """An element property (selection, hiding, material, edge flags), from its attribute where
-    the running Blender keeps one."""
+    """An element property (selection, hiding, material, smooth shading, edge flags), from its
+    attribute where the running Blender keeps one ("sharp_face" holds smooth shading inverted)."""
     name = builtin_attributes().get((collection, prop))
+    if name == "sharp_face":
+        return ~_builtin(me, name, n, np.bool_, False)
     if name is not None:
         return _builtin(me, name, n, dtype, 0)
     return _get(getattr(me, collection), prop, n, dtype)
@@ -245,10 +247,7 @@ def read_mesh(me):
             d.attributes.append((name, attr.data_type, attr.domain))
 
     material = _flag(me, "polygons", "material_index", nf, np.int32)
-    if ("polygons", "use_smooth") in builtin:
-        smooth = ~_builtin(me, "sharp_face", nf, np.bool_, False)
-    else:
-        smooth = _get(me.polygons, "use_smooth", nf, np.bool_)
+    smooth = _flag(me, "polygons", "use_smooth", nf, np.bool_)
     flags = [_flag(me, collection, prop, n, np.bool_) for collection, prop, n in (
         ("vertices", "select", nv), ("polygons", "select", nf), ("vertices", "hide", nv), ("polygons", "hide", nf))]
     channels.append(("material", "face", material))
@@ -537,18 +536,12 @@ def _write_attributes(me, data, result, create, loop_inverse=None):
         if values is None:
             continue
         values = values.view(dtype) if dtype == np.bool_ else values.astype(dtype, copy=False)
-        if create and np.array_equal(_fresh_values(me, collection, prop, dtype), values):
-            continue  # what new geometry holds already (zeros, False; smooth faces from 4.1 on)
+        # What new geometry holds already (zeros, False; smooth faces from 4.1 on), read the fast
+        # way where Blender keeps it as an attribute (new geometry has none but "sharp_face").
+        if create and np.array_equal(_flag(me, collection, prop, len(getattr(me, collection)), dtype), values):
+            continue
         _set(getattr(me, collection), prop, values)
 
-
-def _fresh_values(me, collection, prop, dtype):
-    """What a property of new geometry holds, read the fast way where Blender keeps it as an
-    attribute (new geometry has none of them but, in some versions, "sharp_face")."""
-    n = len(getattr(me, collection))
-    if prop == "use_smooth" and (collection, prop) in builtin_attributes():
-        return ~_builtin(me, "sharp_face", n, np.bool_, False)
-    return _flag(me, collection, prop, n, dtype)
 
 
 def _write_edges(me, data, result):
