@@ -543,7 +543,6 @@ def _write_attributes(me, data, result, create, loop_inverse=None):
         _set(getattr(me, collection), prop, values)
 
 
-
 def _write_edges(me, data, result):
     """Edge data follows the source-vertex pair of each new edge (both ends must come from
     vertices that were joined by an edge carrying the data)."""
