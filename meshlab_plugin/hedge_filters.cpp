@@ -30,10 +30,14 @@ QString filter_info(const Operation& op) {
 int filter_class(const Operation& op) {
   // MeshLab's FilterClass bits (interfaces.h in 2020.09, filter_plugin.h in 2022+).
   switch (op.category) {
-    case Category::cleaning: return 0x00002;
-    case Category::remeshing: return 0x00004;
-    case Category::smoothing: return 0x00080;
-    case Category::measure: return 0x10000;
+    case Category::cleaning:
+      return 0x00002;
+    case Category::remeshing:
+      return 0x00004;
+    case Category::smoothing:
+      return 0x00080;
+    case Category::measure:
+      return 0x10000;
   }
   return 0x00000;  // Generic
 }
@@ -54,6 +58,8 @@ RichKind rich_kind(const ParamSpec& spec) {
       return RichKind::integer;
     case ParamType::choice:
       return RichKind::choice;
+    case ParamType::vertex_channel:
+      return RichKind::text;
     case ParamType::real:
       // A slider needs both ends; an open range (a length, a distance) is a plain field.
       return spec.range.max ? RichKind::bounded_real : RichKind::real;
@@ -73,6 +79,8 @@ const char* rich_type_name(RichKind kind) {
       return "RichDynamicFloat";
     case RichKind::choice:
       return "RichEnum";
+    case RichKind::text:
+      return "RichString";
   }
   return "RichFloat";
 }
@@ -93,15 +101,16 @@ void add_parameters(const Operation& op, RichParameterList& parameters) {
         parameters.addParam(RichBool(name, std::get<bool>(spec.default_value), label, tooltip));
         break;
       case RichKind::integer:
-        parameters.addParam(RichInt(name, int_bound(double(std::get<std::int64_t>(spec.default_value))), label, tooltip));
+        parameters.addParam(
+            RichInt(name, int_bound(double(std::get<std::int64_t>(spec.default_value))), label, tooltip));
         break;
       case RichKind::real:
         parameters.addParam(RichFloat(name, static_cast<float>(std::get<double>(spec.default_value)), label, tooltip));
         break;
       case RichKind::bounded_real:
         parameters.addParam(RichDynamicFloat(name, static_cast<float>(std::get<double>(spec.default_value)),
-                                             static_cast<float>(spec.range.min), static_cast<float>(*spec.range.max), label,
-                                             tooltip));
+                                             static_cast<float>(spec.range.min), static_cast<float>(*spec.range.max),
+                                             label, tooltip));
         break;
       case RichKind::choice: {
         QStringList choices;
@@ -109,6 +118,10 @@ void add_parameters(const Operation& op, RichParameterList& parameters) {
         parameters.addParam(RichEnum(name, static_cast<int>(spec.default_choice()), choices, label, tooltip));
         break;
       }
+      case RichKind::text:
+        parameters.addParam(
+            RichString(name, QString::fromStdString(std::get<std::string>(spec.default_value)), label, tooltip));
+        break;
     }
   }
 }
@@ -130,6 +143,8 @@ std::map<std::string, Value> given_values(const Operation& op, const RichParamet
       given[spec.id] = static_cast<std::int64_t>(value.getInt());
     else if (value.isFloat())
       given[spec.id] = real_from_float(value.getFloat());
+    else if (value.isString())
+      given[spec.id] = value.getString().toStdString();
     else
       given[spec.id] = value.typeName().toStdString();  // a type hedge never declares: refused by name
   }

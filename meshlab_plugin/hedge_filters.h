@@ -31,7 +31,7 @@ int precondition_mask(const Operation& op);
 int postcondition_mask(const Operation& op);
 
 //! Which Rich parameter class holds a parameter.
-enum class RichKind { boolean, integer, real, bounded_real, choice };
+enum class RichKind { boolean, integer, real, bounded_real, choice, text };
 //! Reals with both ends get a slider (RichDynamicFloat); reals with no upper limit are plain
 //! RichFloat fields.
 RichKind rich_kind(const ParamSpec& spec);

@@ -163,8 +163,15 @@ class Batch:
         return self.index >= len(self.targets)
 
     def read_next(self):
-        """The soup of the next mesh to run."""
-        return self.targets[self.index].read(self.op)
+        """The soup of the next mesh to run, and the parameters for it: a vertex attribute
+        named by a parameter may be a vertex group of that mesh."""
+        t = self.targets[self.index]
+        soup = t.read(self.op)
+        params = dict(self.params)
+        for p in self.op["params"]:
+            if p["type"] == "vertex_channel" and p["id"] in params:
+                params[p["id"]] = exchange.vertex_attribute_channel(t.data, params[p["id"]])
+        return soup, params
 
     def record(self, result, report):
         """Keeps the next mesh's result (from native.run or a Job)."""
@@ -199,8 +206,8 @@ def run_targets(op_id, target_list, params, progress=None):
             if progress is not None:
                 def step(fraction, stage, i=batch.index):
                     return progress((i + fraction) / n, stage)
-            soup = batch.read_next()
-            batch.record(*native_module.run(op_id, soup, batch.params, step))
+            soup, params = batch.read_next()
+            batch.record(*native_module.run(op_id, soup, params, step))
         return batch.commit()
     except BaseException:
         batch.release()

@@ -32,6 +32,7 @@ from .native import Error
 # Blender attribute type -> (foreach property, numpy dtype, components)
 # (a type the running Blender lacks never occurs: 3.4 has the first eight types below, 4.3 adds
 # INT32_2D, QUATERNION and FLOAT4X4, 5.2 also INT16_2D and FLOAT4)
+ATTRIBUTE_PREFIX = "attr:"  # a generic attribute's channel: "attr:<name>"
 ATTRIBUTE_TYPES = {
     'FLOAT': ("value", np.float32, 1),
     'INT': ("value", np.int32, 1),
@@ -228,7 +229,7 @@ def read_mesh(me):
         prop, dtype, comps = kind
         if attr.domain == 'EDGE':
             d.edge_attributes.append((name, attr.data_type))
-            d.edge_data["attr:" + name] = _get(attr.data, prop, ne, dtype, comps)
+            d.edge_data[ATTRIBUTE_PREFIX + name] = _get(attr.data, prop, ne, dtype, comps)
             continue
         domain = DOMAINS.get(attr.domain)
         if domain is None:
@@ -243,7 +244,7 @@ def read_mesh(me):
             channels.append(("color:" + name, domain, values))
             d.colors.append((name, attr.data_type, attr.domain))
         else:
-            channels.append(("attr:" + name, domain, values))
+            channels.append((ATTRIBUTE_PREFIX + name, domain, values))
             d.attributes.append((name, attr.data_type, attr.domain))
 
     material = _flag(me, "polygons", "material_index", nf, np.int32)
@@ -284,6 +285,19 @@ def read_mesh(me):
 
 def _socket(sockets, name, kind):
     return next(s for s in sockets if s.name == name and s.type == kind)
+
+
+GROUP_PREFIX = "vgroup:"
+
+
+def vertex_attribute_channel(data, name):
+    """The channel a parameter naming a vertex attribute means: the vertex group `name` when
+    the object has one (read_vertex_groups), else the point attribute `name`; a name that is
+    neither goes as it is, for the operation to refuse."""
+    if name and name in data.vertex_groups:
+        return GROUP_PREFIX + name
+    channels = {c[0] for c in data.soup["channels"] if c[1] == "vertex"}
+    return ATTRIBUTE_PREFIX + name if ATTRIBUTE_PREFIX + name in channels else name
 
 
 def read_vertex_groups(obj, me, data):
@@ -327,7 +341,7 @@ def read_vertex_groups(obj, me, data):
                 raise RuntimeError("the evaluated mesh has other vertices")
             for i, name in enumerate(names):
                 weights = _get(result.attributes[f"hedge_group_{i}"].data, "value", nv, np.float32)
-                data.soup["channels"].append(("vgroup:" + name, "vertex", weights))
+                data.soup["channels"].append((GROUP_PREFIX + name, "vertex", weights))
         finally:
             evaluated.to_mesh_clear()
         data.vertex_groups = names
@@ -430,7 +444,7 @@ def write_vertex_groups(obj, me, data, result):
         if name in obj.vertex_groups:
             obj.vertex_groups.remove(obj.vertex_groups[name])
     for name in data.vertex_groups:
-        weights = channel(result, "vgroup:" + name, "vertex")
+        weights = channel(result, GROUP_PREFIX + name, "vertex")
         attr = me.attributes.new(name, 'FLOAT', 'POINT')
         if weights is not None:
             _set(attr.data, "value", weights)
@@ -500,7 +514,7 @@ def _write_attributes(me, data, result, create, loop_inverse=None):
         if data.render_uv and data.render_uv in me.uv_layers:
             me.uv_layers[data.render_uv].active_render = True
 
-    for prefix, entries in (("color:", data.colors), ("attr:", data.attributes)):
+    for prefix, entries in (("color:", data.colors), (ATTRIBUTE_PREFIX, data.attributes)):
         for name, data_type, bl_domain in entries:
             values = channel(soup, prefix + name, DOMAINS[bl_domain])
             if values is None:
@@ -564,13 +578,13 @@ def _write_edges(me, data, result):
     found = (sorted_keys[pos] == new_keys) & (src[:, 0] != src[:, 1])
     match = order[pos]
     for name, values in data.edge_data.items():
-        if name.startswith("attr:"):
+        if name.startswith(ATTRIBUTE_PREFIX):
             continue
         out = np.zeros(ne, values.dtype)
         out[found] = values[match[found]]
         _set(me.edges, name, out)
     for name, data_type in data.edge_attributes:
-        values = data.edge_data["attr:" + name]
+        values = data.edge_data[ATTRIBUTE_PREFIX + name]
         prop, dtype, comps = ATTRIBUTE_TYPES[data_type]
         attr = new_attribute(me, name, data_type, 'EDGE')
         out = np.zeros((ne, comps) if comps > 1 else ne, values.dtype)

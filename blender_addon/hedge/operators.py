@@ -48,7 +48,22 @@ def make_property(p):
     if p["type"] == "enum":
         items = [(c, c.replace("_", " ").title(), f"{p['help']} ({c})") for c in p["choices"]]
         return bpy.props.EnumProperty(name=p["label"], description=help_text, items=items, default=p["default"])
+    if p["type"] == "vertex_channel":
+        return bpy.props.StringProperty(name=p["label"], description=help_text, default=p["default"],
+                                        search=vertex_attribute_names, search_options={'SUGGESTION', 'SORT'})
     raise Error(f"parameter {p['id']}: unknown type {p['type']}")
+
+
+def vertex_attribute_names(self, context, edit_text):
+    """What a vertex-attribute field suggests: the active object's vertex groups and its
+    one-number point attributes (typing another name stays allowed)."""
+    obj = context.active_object
+    if obj is None or obj.type != 'MESH':
+        return []
+    names = [g.name for g in obj.vertex_groups]
+    names += [a.name for a in obj.data.attributes if a.domain == 'POINT' and not a.name.startswith(".")
+              and a.data_type in ('FLOAT', 'INT', 'BOOLEAN', 'INT8') and a.name not in names and a.name != "position"]
+    return [n for n in names if edit_text.lower() in n.lower()]
 
 
 class HedgeOperator:
@@ -126,7 +141,7 @@ class HedgeOperator:
 
     def _next(self):
         if not self._batch.finished():
-            self._job = require_native().Job(self.operation["id"], self._batch.read_next(), self._batch.params)
+            self._job = require_native().Job(self.operation["id"], *self._batch.read_next())
 
     def _release(self):
         self._batch.release()

@@ -24,6 +24,8 @@ const char* param_type_name(ParamType type) {
       return "float";
     case ParamType::choice:
       return "enum";
+    case ParamType::vertex_channel:
+      return "vertex_channel";
   }
   return "unknown";
 }
@@ -75,6 +77,8 @@ std::string ParamSpec::range_text() const {
       for (std::size_t i = 0; i < choices.size(); ++i) out += (i ? ", " : " ") + choices[i];
       return out;
     }
+    case ParamType::vertex_channel:
+      return "a vertex attribute's name, or empty for none";
   }
   return "";
 }
@@ -104,6 +108,7 @@ bool ParamValues::get_bool(const std::string& id) const { return std::get<bool>(
 std::int64_t ParamValues::get_int(const std::string& id) const { return std::get<std::int64_t>(at(id)); }
 double ParamValues::get_real(const std::string& id) const { return std::get<double>(at(id)); }
 const std::string& ParamValues::get_choice(const std::string& id) const { return std::get<std::string>(at(id)); }
+const std::string& ParamValues::get_text(const std::string& id) const { return std::get<std::string>(at(id)); }
 
 const Value* OperationReport::find(const std::string& key) const {
   for (const auto& [k, v] : entries)
@@ -264,6 +269,9 @@ Value check_value(const Operation& op, const ParamSpec& p, const Value& value) {
         return p.choices[std::size_t(*i)];
       refuse(op, p, text);
     }
+    case ParamType::vertex_channel:
+      if (const auto* s = std::get_if<std::string>(&value)) return *s;
+      refuse(op, p, text);
   }
   refuse(op, p, text);
 }
@@ -287,6 +295,7 @@ Value parse_text(const Operation& op, const ParamSpec& p, const std::string& tex
       return d;
     }
     case ParamType::choice:
+    case ParamType::vertex_channel:
       return text;
   }
   refuse(op, p, text);

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <cstring>
 
+#include "hedge/error.h"
 #include "welded_copies.h"
 
 namespace hedge::detail {
@@ -19,6 +21,40 @@ std::vector<std::uint8_t> flags_of(const ChannelArray* channel, std::size_t n) {
     out[i] = std::any_of(e, e + stride, [](std::byte b) { return b != std::byte{0}; });
   }
   return out;
+}
+
+template <class T>
+double number_at(const std::byte* element) {
+  T x;
+  std::memcpy(&x, element, sizeof x);
+  return static_cast<double>(x);
+}
+
+double scalar_at(const ChannelArray& channel, std::size_t i) {
+  const std::byte* e = channel.element(i);
+  switch (channel.scalar()) {
+    case ScalarType::f32:
+      return number_at<float>(e);
+    case ScalarType::f64:
+      return number_at<double>(e);
+    case ScalarType::i8:
+      return number_at<std::int8_t>(e);
+    case ScalarType::u8:
+      return number_at<std::uint8_t>(e);
+    case ScalarType::i16:
+      return number_at<std::int16_t>(e);
+    case ScalarType::u16:
+      return number_at<std::uint16_t>(e);
+    case ScalarType::i32:
+      return number_at<std::int32_t>(e);
+    case ScalarType::u32:
+      return number_at<std::uint32_t>(e);
+    case ScalarType::i64:
+      return number_at<std::int64_t>(e);
+    case ScalarType::u64:
+      return number_at<std::uint64_t>(e);
+  }
+  return 0;
 }
 }  // namespace
 
@@ -49,6 +85,24 @@ std::vector<std::uint8_t> inside_selection(const Mesh& mesh, const std::vector<s
     }
     out[v.idx()] = inside;
   }
+  return out;
+}
+
+std::vector<double> vertex_values(const Mesh& mesh, const std::string& name, const std::string& what) {
+  const PropertyContainer& properties = mesh.vertex_properties();
+  const ChannelArray* channel = properties.get_channel(name);
+  if (!channel) {
+    std::string known;
+    for (const std::string& n : properties.names())
+      if (properties.get_channel(n) && !properties.find(n)->is_internal()) known += (known.empty() ? "" : ", ") + n;
+    throw Error(what + ": the mesh has no vertex attribute '" + name + "'" +
+                (known.empty() ? " (it has none)" : "; its vertex attributes are: " + known));
+  }
+  if (channel->components() != 1)
+    throw Error(what + ": the vertex attribute '" + name + "' holds " + std::to_string(channel->components()) +
+                " numbers per vertex; one is needed");
+  std::vector<double> out(mesh.vertices_size(), 0);
+  for (std::size_t i = 0; i < std::min(out.size(), channel->size()); ++i) out[i] = scalar_at(*channel, i);
   return out;
 }
 

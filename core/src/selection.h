@@ -1,6 +1,7 @@
 // selection_only: what a host's selection lets an operation change. build() carries the
 // selection as the "selected" channels of faces and vertices (soup.h: u8, non-zero means
-// selected); operations read it here, once, as flags per element index.
+// selected); operations read it here, once, as flags per element index. Also here: the
+// per-vertex values a user names by attribute (weights, locks), read the same way.
 //
 // The contract every operation with selection_only keeps: a face that is not selected comes
 // back as it was (same corners, same positions), so the border between selected and
@@ -8,6 +9,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "hedge/mesh.h"
@@ -29,6 +31,12 @@ std::vector<std::uint8_t> inside_selection(const Mesh& mesh, const std::vector<s
 
 //! Whether the host selected any face or vertex.
 bool has_selection(const Mesh& mesh);
+
+//! Per vertex index: the value of the one-component vertex channel `name` (any scalar type),
+//! for parameters of type vertex_channel. Throws Error naming `what` (e.g. "decimate:
+//! weight_attribute") and the mesh's vertex attributes when there is no such channel, or
+//! when it holds more than one number per vertex.
+std::vector<double> vertex_values(const Mesh& mesh, const std::string& name, const std::string& what);
 
 //! The message a run with selection_only gives when nothing is selected.
 inline constexpr const char* kNothingSelected = "selection_only: nothing is selected, so the mesh is unchanged";

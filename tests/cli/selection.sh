@@ -11,29 +11,11 @@ bunny=$MESHES/bunny.off
 [ -f "$bunny" ] || { echo "FAIL: missing $bunny: run scripts/fetch_meshes" >&2; exit 1; }
 
 "$HEDGE" convert "$bunny" "$work/bunny.ply" --ascii
-python3 - "$HEDGE" "$work" <<'PY'
+python3 - "$HEDGE" "$work" "$(dirname "$0")" <<'PY'
 import json, subprocess, sys
 hedge, work = sys.argv[1], sys.argv[2]
-
-
-def read_ply(path):
-    """An ASCII PLY as hedge writes it: (vertex rows, face rows, face property names)."""
-    lines = open(path).read().split("\n")
-    end = lines.index("end_header")
-    header = lines[:end]
-    counts, props, current = {}, {"vertex": [], "face": []}, None
-    for line in header:
-        words = line.split()
-        if words[:1] == ["element"]:
-            current = words[1]
-            counts[current] = int(words[2])
-        elif words[:1] == ["property"]:
-            props[current].append(words[-1])
-    body = lines[end + 1:]
-    nv = counts["vertex"]
-    vertices = [list(map(float, l.split())) for l in body[:nv]]
-    faces = [l.split() for l in body[nv:nv + counts["face"]]]
-    return vertices, faces, props
+sys.path.insert(0, sys.argv[3])
+from ascii_ply import read_ply  # noqa: E402
 
 
 def write_ply(path, vertices, faces, selected):

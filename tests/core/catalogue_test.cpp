@@ -55,6 +55,9 @@ TEST(Catalogue, EveryOperationIsWellDeclared) {
       if (p.type == ParamType::boolean) {
         EXPECT_TRUE(std::holds_alternative<bool>(p.default_value)) << op.id << "." << p.id;
       }
+      if (p.type == ParamType::vertex_channel) {
+        EXPECT_EQ(p.default_value, Value(std::string())) << op.id << "." << p.id << ": none by default";
+      }
     }
     // Defaults always resolve.
     EXPECT_NO_THROW(resolve_params(op, std::map<std::string, std::string>{})) << op.id;
@@ -93,6 +96,10 @@ TEST(Catalogue, ParametersAreChecked) {
           break;
         case ParamType::choice:
           bad = {"no_such_choice"};
+          break;
+        case ParamType::vertex_channel:
+          // Any name resolves; the operation refuses one its mesh lacks (Decimate.WeightAndLockNames*).
+          EXPECT_THROW(resolve_params(op, std::map<std::string, Value>{{p.id, Value(1.5)}}), Error);
           break;
       }
       for (const auto& value : bad) {

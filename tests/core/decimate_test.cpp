@@ -523,6 +523,148 @@ TEST(Decimate, VertexAttributesAreInterpolated) {
   EXPECT_LT(worst, 0.05);  // of a range of 3
 }
 
+// ---- weights and locks ------------------------------------------------------------------------
+
+// An icosphere with a vertex channel: `value(position)` at each vertex.
+template <class T, class F>
+Soup sphere_with(const std::string& name, ScalarType scalar, F value) {
+  Soup s = icosphere(5);
+  T* c = s.add_channel(name, Domain::vertex, scalar, 1).as<T>();
+  for (std::size_t i = 0; i < s.n_vertices(); ++i) c[i] = static_cast<T>(value(s.positions[i]));
+  return s;
+}
+
+std::size_t faces_with_positive_x(const Mesh& mesh) {
+  std::size_t n = 0;
+  for (Face f : mesh.faces()) {
+    double x = 0;
+    for (Vertex v : mesh.vertices(f)) x += mesh.position(v)[0];
+    n += x > 0;
+  }
+  return n;
+}
+
+TEST(Decimate, LockedVerticesNeitherMoveNorGo) {
+  // A cap of the sphere and every 20th vertex elsewhere locked: each is in the result, where
+  // it was, and the rest still goes down to the target.
+  auto is_locked = [](const Point& p) { return p[2] > 0.9 || std::fmod(std::abs(p[0]) * 1e4, 20) < 1; };
+  const Soup s = sphere_with<std::uint8_t>("lock", ScalarType::u8, is_locked);
+  std::set<std::array<double, 3>> locked;
+  for (const Point& p : s.positions)
+    if (is_locked(p)) locked.insert({p[0], p[1], p[2]});
+  ASSERT_GT(locked.size(), 100u);
+  Mesh mesh = build(s).mesh;
+  DecimateOptions o;
+  o.target_ratio = 0.2;
+  o.lock_attribute = "lock";
+  const DecimateReport r = decimate(mesh, o);
+  expect_clean(mesh);
+  EXPECT_EQ(r.locked_vertices, locked.size());
+  std::printf("%zu of %zu vertices locked: %zu faces left\n", locked.size(), s.n_vertices(), mesh.n_faces());
+  std::size_t found = 0;
+  for (Vertex v : mesh.vertices()) {
+    const Point& p = mesh.position(v);
+    found += locked.count({p[0], p[1], p[2]});
+  }
+  EXPECT_EQ(found, locked.size());
+  EXPECT_EQ(r.stopped_by, "target reached");
+}
+
+TEST(Decimate, WeightsKeepMoreTrianglesWhereTheyAreHigh) {
+  // Weight 1 on the half x > 0: that half keeps far more of the triangles than the other.
+  const Soup s = sphere_with<float>("density", ScalarType::f32, [](const Point& p) { return p[0] > 0 ? 1.0 : 0.0; });
+  Mesh plain = build(s).mesh, weighted = plain;
+  DecimateOptions o;
+  o.target_ratio = 0.1;
+  decimate(plain, o);
+  o.weight_attribute = "density";
+  const DecimateReport r = decimate(weighted, o);
+  expect_clean(weighted);
+  EXPECT_EQ(weighted.n_faces(), plain.n_faces());
+  EXPECT_TRUE(r.messages.empty());
+  const double share_plain = double(faces_with_positive_x(plain)) / double(plain.n_faces());
+  const double share_weighted = double(faces_with_positive_x(weighted)) / double(weighted.n_faces());
+  std::printf("faces on the weighted half: %.2f of all (unweighted run: %.2f)\n", share_weighted, share_plain);
+  EXPECT_NEAR(share_plain, 0.5, 0.1);
+  // Quadric costs grow about as the sixth power of the edge length here, so 11 times the cost
+  // buys about 1.5 times shorter edges.
+  EXPECT_GT(share_weighted, 0.62);
+  Mesh strong = build(s).mesh;
+  o.weight_strength = 1000;
+  decimate(strong, o);
+  const double share_strong = double(faces_with_positive_x(strong)) / double(strong.n_faces());
+  std::printf("with strength 1000: %.2f\n", share_strong);
+  EXPECT_GT(share_strong, 0.8);
+  // No strength, no effect.
+  Mesh none = build(s).mesh;
+  o.weight_strength = 0;
+  decimate(none, o);
+  EXPECT_EQ(extract(none).positions, extract(plain).positions);
+}
+
+TEST(Decimate, WeightsOutsideZeroToOneAreRescaled) {
+  // MeshLab's quality runs over any range: 100 x the weights of above gives the same result.
+  const auto half = [](const Point& p) { return p[0] > 0 ? 1.0 : 0.0; };
+  Mesh unit = build(sphere_with<float>("quality", ScalarType::f32, half)).mesh;
+  Mesh hundred =
+      build(sphere_with<float>("quality", ScalarType::f32, [&](const Point& p) { return 100 * half(p); })).mesh;
+  DecimateOptions o;
+  o.target_ratio = 0.1;
+  o.weight_attribute = "quality";
+  decimate(unit, o);
+  const DecimateReport r = decimate(hundred, o);
+  ASSERT_EQ(r.messages.size(), 1u);
+  EXPECT_NE(r.messages[0].find("rescaled"), std::string::npos) << r.messages[0];
+  EXPECT_EQ(extract(unit).positions, extract(hundred).positions);
+}
+
+TEST(Decimate, WeightAndLockNamesTheMeshLacksAreRefused) {
+  Soup s = sphere_with<float>("density", ScalarType::f32, [](const Point&) { return 0.5; });
+  s.add_channel("colour", Domain::vertex, ScalarType::f32, 3);
+  Mesh mesh = build(s).mesh;
+  const Soup before = extract(mesh);
+  for (auto [weight, lock, says] : std::vector<std::tuple<std::string, std::string, std::string>>{
+           {"nope", "", "weight_attribute: the mesh has no vertex attribute 'nope'; its vertex attributes are: "},
+           {"", "nope", "lock_attribute: the mesh has no vertex attribute 'nope'"},
+           {"colour", "", "'colour' holds 3 numbers per vertex; one is needed"}}) {
+    DecimateOptions o;
+    o.target_ratio = 0.1;
+    o.weight_attribute = weight;
+    o.lock_attribute = lock;
+    try {
+      decimate(mesh, o);
+      ADD_FAILURE() << "accepted " << weight << lock;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(says), std::string::npos) << e.what();
+      if (weight == "nope") {
+        EXPECT_NE(std::string(e.what()).find("density"), std::string::npos) << e.what();
+      }
+    }
+    EXPECT_EQ(extract(mesh), before);
+  }
+}
+
+TEST(Decimate, WeightsAndLocksThroughTheCatalogue) {
+  // As the CLI and the hosts pass them: names as text.
+  Soup s = sphere_with<float>("density", ScalarType::f32, [](const Point& p) { return p[0] > 0 ? 1.0 : 0.0; });
+  std::uint8_t* lock = s.add_channel("pin", Domain::vertex, ScalarType::u8, 1).as<std::uint8_t>();
+  lock[0] = 1;
+  const Operation& op = find_operation("decimate");
+  const RunResult r =
+      run_operation(op, s,
+                    resolve_params(op, std::map<std::string, std::string>{{"target_ratio", "0.1"},
+                                                                          {"weight_attribute", "density"},
+                                                                          {"lock_attribute", "pin"}}),
+                    Progress::none());
+  ASSERT_NE(r.report.find("locked_vertices"), nullptr);
+  EXPECT_EQ(std::get<std::int64_t>(*r.report.find("locked_vertices")), 1);
+  EXPECT_NE(std::find(r.soup.positions.begin(), r.soup.positions.end(), s.positions[0]), r.soup.positions.end());
+  // Without a lock attribute the report does not mention locks.
+  const RunResult plain =
+      run_operation(op, s, resolve_params(op, std::map<std::string, std::string>{}), Progress::none());
+  EXPECT_EQ(plain.report.find("locked_vertices"), nullptr);
+}
+
 // ---- contracts -----------------------------------------------------------------------------
 
 TEST(Decimate, Deterministic) {

@@ -52,12 +52,12 @@ hedge::Soup grid(int n, bool triangles) {
 hedge::Soup icosahedron() {
   hedge::Soup s;
   const float t = 1.618034f;
-  float v[12][3] = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
-                    {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+  float v[12][3] = {{-1, t, 0},  {1, t, 0},  {-1, -t, 0}, {1, -t, 0}, {0, -1, t},  {0, 1, t},
+                    {0, -1, -t}, {0, 1, -t}, {t, 0, -1},  {t, 0, 1},  {-t, 0, -1}, {-t, 0, 1}};
   for (auto& p : v) s.positions.push_back({p[0], p[1], p[2]});
-  std::uint32_t f[20][3] = {{0, 11, 5}, {0, 5, 1}, {0, 1, 7}, {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
-                            {11, 10, 2}, {10, 7, 6}, {7, 1, 8}, {3, 9, 4}, {3, 4, 2}, {3, 2, 6}, {3, 6, 8},
-                            {3, 8, 9}, {4, 9, 5}, {2, 4, 11}, {6, 2, 10}, {8, 6, 7}, {9, 8, 1}};
+  std::uint32_t f[20][3] = {{0, 11, 5},  {0, 5, 1},  {0, 1, 7},  {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+                            {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
+                            {3, 8, 9},   {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
   for (auto& t3 : f) s.add_face({t3[0], t3[1], t3[2]});
   return s;
 }
@@ -329,8 +329,7 @@ bool is_delete_face_ok(const Mesh& mesh, Face f) {
   Halfedge h0 = mesh.halfedge(f), h = h0;
   do {
     Vertex v = mesh.to_vertex(h);
-    if (mesh.is_boundary(v) && !mesh.is_boundary(Mesh::opposite(h)) &&
-        !mesh.is_boundary(Mesh::opposite(mesh.next(h))))
+    if (mesh.is_boundary(v) && !mesh.is_boundary(Mesh::opposite(h)) && !mesh.is_boundary(Mesh::opposite(mesh.next(h))))
       return false;
     h = mesh.next(h);
   } while (h != h0);
@@ -342,9 +341,15 @@ hedge::ParamValues draw_params(FuzzedDataProvider& in, const hedge::Operation& o
   for (const auto& p : op.params) {
     if (in.ConsumeBool()) continue;  // default
     switch (p.type) {
-      case hedge::ParamType::boolean: given[p.id] = in.ConsumeBool(); break;
+      case hedge::ParamType::boolean:
+        given[p.id] = in.ConsumeBool();
+        break;
       case hedge::ParamType::choice:
         given[p.id] = p.choices[in.ConsumeIntegralInRange<std::size_t>(0, p.choices.size() - 1)];
+        break;
+      case hedge::ParamType::vertex_channel:
+        // The fuzzed meshes carry no attributes: a name exercises the refusal.
+        given[p.id] = std::string(in.ConsumeBool() ? "" : "no_such_attribute");
         break;
       case hedge::ParamType::integer: {
         // Small values only: iteration counts and sizes multiply the work.
@@ -410,11 +415,21 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   // replay as they did with a zero byte inserted before their last.)
   const int shape = in.ConsumeIntegralInRange<int>(0, 4), glue = in.ConsumeIntegralInRange<int>(0, 7);
   switch (shape) {
-    case 0: soup = grid(3, true); break;
-    case 1: soup = grid(3, false); break;
-    case 2: soup = icosahedron(); break;
-    case 3: soup = cube(); break;
-    default: soup = random_faces(in); break;
+    case 0:
+      soup = grid(3, true);
+      break;
+    case 1:
+      soup = grid(3, false);
+      break;
+    case 2:
+      soup = icosahedron();
+      break;
+    case 3:
+      soup = cube();
+      break;
+    default:
+      soup = random_faces(in);
+      break;
   }
   add_defects(in, soup, glue);
   hedge::BuildResult built;

@@ -8,7 +8,7 @@ import math
 def cases(p):
     """[(value, accepted)] for parameter `p` (a catalogue dict of `hedge list --json`):
     integers and reals at min and max and the nearest values beyond, every choice of an enum
-    and one that is not, both booleans. A parameter with no upper limit (max None) takes a
+    and one that is not, both booleans, no vertex attribute and one the mesh lacks. A parameter with no upper limit (max None) takes a
     large value instead of its max."""
     if p["type"] == "int":
         if p["max"] is None:
@@ -24,6 +24,9 @@ def cases(p):
         return [(c, True) for c in p["choices"]] + [("no_such_" + p["id"], False)]
     if p["type"] == "bool":
         return [(True, True), (False, True)]
+    if p["type"] == "vertex_channel":
+        # Empty is "none"; any name resolves, and the operation refuses one the mesh lacks.
+        return [("", True), ("no_such_attribute", False)]
     raise ValueError(f"unknown parameter type {p['type']}")
 
 
@@ -41,5 +44,8 @@ def text(value):
 
 
 def refusal_names_parameter(message, op_id, p):
-    """A refusal names the operation, the parameter and what is allowed."""
+    """A refusal names the operation, the parameter and what is allowed (for a vertex
+    attribute: that the mesh has none of that name)."""
+    if p["type"] == "vertex_channel":
+        return f"{op_id}: {p['id']}: the mesh has no vertex attribute" in message
     return f"{op_id}: parameter {p['id']} must be {p['range_text']}" in message

@@ -26,6 +26,8 @@ def parse_value(p, text):
         return int(text)
     if p["type"] == "float":
         return float(text)
+    if p["type"] == "vertex_channel":
+        return text
     return text if text in p["choices"] else int(text)
 
 

@@ -369,6 +369,8 @@ def param_xml(p, value):
         attributes["enum_cardinality"] = str(len(p["choices"]))
         for i, choice in enumerate(p["choices"]):
             attributes[f"enum_val{i}"] = choice
+    elif rich == "RichString":
+        attributes["value"] = str(value)
     else:
         raise Failure(f"unknown Rich type {rich}")
     return attributes

@@ -23,8 +23,10 @@
 #include <QApplication>
 #include <QPluginLoader>
 #include <algorithm>
+#include <array>
 #include <cstdlib>
 #include <map>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -327,8 +329,53 @@ TEST_F(PluginTest, SelectionOnlyKeepsTheFacesOutsideTheSelection) {
     ASSERT_TRUE(doc.apply(op_id, parameters)) << doc.log_text();
     EXPECT_EQ(faces_selected(m, false), outside);
     EXPECT_NE(faces_selected(m, true), inside);
-    if (std::string(op_id) == "decimate") EXPECT_LT(m.fn, static_cast<int>(outside.size() + inside.size()));
+    if (std::string(op_id) == "decimate") {
+      EXPECT_LT(m.fn, static_cast<int>(outside.size() + inside.size()));
+    }
   }
+}
+
+// Decimate's weights and locks name vertex attributes: MeshLab's vertex quality, and any
+// per-vertex attribute a filter or script added.
+TEST_F(PluginTest, DecimateWeighsByQualityAndKeepsLockedVertices) {
+  auto faces_right_of = [](const CMeshO& m, float median) {
+    int n = 0;
+    for (const CFaceO& f : m.face) n += !f.IsD() && f.cP(0)[0] + f.cP(1)[0] + f.cP(2)[0] > 3 * median;
+    return n;
+  };
+  Document plain(mesh_path("bunny.off")), weighted(mesh_path("bunny.off"));
+  CMeshO& m = weighted.model->cm;
+  std::vector<float> xs;
+  for (const CVertexO& v : m.vert) xs.push_back(v.cP()[0]);
+  std::nth_element(xs.begin(), xs.begin() + std::ptrdiff_t(xs.size() / 2), xs.end());
+  const float median = xs[xs.size() / 2];
+  weighted.model->updateDataMask(MeshModel::MM_VERTQUALITY);
+  auto pin = vcg::tri::Allocator<CMeshO>::AddPerVertexAttribute<float>(m, "pin");
+  std::vector<std::array<float, 3>> pinned;
+  for (std::size_t i = 0; i < m.vert.size(); ++i) {
+    m.vert[i].Q() = m.vert[i].cP()[0] > median ? 1.0f : 0.0f;
+    pin[i] = i % 50 == 0 ? 1.0f : 0.0f;
+    if (pin[i] != 0) pinned.push_back({m.vert[i].cP()[0], m.vert[i].cP()[1], m.vert[i].cP()[2]});
+  }
+  RichParameterList parameters = weighted.defaults(action_of("decimate"));
+  parameters.setValue("target_ratio", DynamicFloatValue(0.1f));
+  RichParameterList plain_parameters = parameters;
+  parameters.setValue("weight_attribute", StringValue("quality"));
+  parameters.setValue("lock_attribute", StringValue("pin"));
+  ASSERT_TRUE(plain.apply("decimate", plain_parameters)) << plain.log_text();
+  ASSERT_TRUE(weighted.apply("decimate", parameters)) << weighted.log_text();
+  EXPECT_GT(faces_right_of(m, median), faces_right_of(plain.model->cm, median) * 5 / 4);
+  std::set<std::array<float, 3>> after;
+  for (const CVertexO& v : m.vert)
+    if (!v.IsD()) after.insert({v.cP()[0], v.cP()[1], v.cP()[2]});
+  for (const auto& p : pinned) EXPECT_TRUE(after.count(p)) << "a locked vertex moved or went";
+  // A name the mesh lacks is refused, and the mesh is untouched.
+  const int faces = m.fn;
+  parameters.setValue("weight_attribute", StringValue("no_such_attribute"));
+  EXPECT_FALSE(weighted.apply("decimate", parameters));
+  EXPECT_NE(weighted.log_text().find("no vertex attribute 'no_such_attribute'"), std::string::npos)
+      << weighted.log_text();
+  EXPECT_EQ(m.fn, faces);
 }
 
 TEST_F(PluginTest, DeletedElementsAreSkippedAndTheResultIsCompact) {

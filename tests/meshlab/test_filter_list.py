@@ -10,7 +10,7 @@ import subprocess
 import meshlab_test as mt
 
 EXPECTED_TYPES = {"bool": {"RichBool"}, "int": {"RichInt"}, "float": {"RichFloat", "RichDynamicFloat"},
-                  "enum": {"RichEnum"}}
+                  "enum": {"RichEnum"}, "vertex_channel": {"RichString"}}
 # MeshModel's bits: MM_FACENUMBER; MM_GEOMETRY_AND_TOPOLOGY_CHANGE; MM_NONE.
 PRECONDITION = 0x00080000
 CHANGES_MESH, NO_CHANGE = 0x431E7BE7, 0x00000000

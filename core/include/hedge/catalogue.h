@@ -22,7 +22,9 @@ namespace hedge {
 using Value = std::variant<bool, std::int64_t, double, std::string>;
 std::string value_text(const Value& value);
 
-enum class ParamType { boolean, integer, real, choice };
+//! vertex_channel: the name of a vertex attribute of the mesh (a Soup vertex channel), empty
+//! for none; a value that names no channel is refused by the operation, which knows the mesh.
+enum class ParamType { boolean, integer, real, choice, vertex_channel };
 const char* param_type_name(ParamType type);
 
 //! Where operations appear: MeshLab's filter classes, Blender's panel groups, `hedge list`.
@@ -59,7 +61,7 @@ struct ParamSpec {
   std::size_t default_choice() const;
   //! The default as text, as a user would type it.
   std::string default_text() const;
-  //! "0 to 1", "one of loop, catmull_clark", "true or false".
+  //! "0 to 1", "one of loop, catmull_clark", "true or false", "a vertex attribute's name".
   std::string range_text() const;
 };
 
@@ -105,6 +107,7 @@ class ParamValues {
   std::int64_t get_int(const std::string& id) const;
   double get_real(const std::string& id) const;
   const std::string& get_choice(const std::string& id) const;
+  const std::string& get_text(const std::string& id) const;  //!< vertex_channel
   void set(const std::string& id, Value value) { values_[id] = std::move(value); }
   const std::map<std::string, Value>& all() const { return values_; }
 

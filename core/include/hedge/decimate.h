@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "hedge/mesh.h"
 #include "hedge/progress.h"
@@ -42,6 +43,16 @@ struct DecimateOptions {
   //! vertices with a face outside the selection neither move nor go, and target_ratio applies
   //! to the selected faces (target_faces stays a count of all faces).
   bool selection_only = false;
+  //! A vertex attribute (one number per vertex; in Blender a vertex group, in MeshLab
+  //! "quality") saying where detail matters: a vertex of weight w counts its error
+  //! 1 + weight_strength * w times, so weighted regions keep more triangles. Weights are
+  //! taken as 0 to 1; values outside that range are first rescaled from their minimum and
+  //! maximum. Empty: no weights.
+  std::string weight_attribute;
+  double weight_strength = 10;
+  //! A vertex attribute whose non-zero vertices are locked: they neither move nor go.
+  //! Empty: none.
+  std::string lock_attribute;
   //! Threads for measuring every edge before the first collapse (the collapses themselves
   //! are sequential); the result is the same for any count. 0: hedge::thread_count().
   unsigned threads = 0;
@@ -56,11 +67,13 @@ struct DecimateReport {
   std::size_t target_faces = 0;
   std::size_t triangulated_faces = 0;  //!< polygons split into triangles first
   std::size_t collapses = 0;
+  std::size_t locked_vertices = 0;  //!< by lock_attribute
   //! Largest error of a collapse done, as a fraction of the bounding-box diagonal.
   double max_error = 0;
   //! Why it stopped: "target reached", "max_error reached", "no legal collapse left",
   //! "target is odd on a closed surface" (stopped one face above it), "nothing to do".
   std::string stopped_by;
+  std::vector<std::string> messages;  //!< what a user should know about the weights
 };
 
 //! Simplifies a triangle mesh to options.target_faces triangles (or target_ratio of them)

@@ -102,6 +102,16 @@ class Binding {
     return *this;
   }
 
+  //! A vertex attribute picked by name (ParamType::vertex_channel), empty for none. The
+  //! operation looks it up in the mesh and refuses a name it does not find.
+  Binding& vertex_channel(std::string Options::*field, std::string id, std::string label, std::string help) {
+    add_param(ParamType::vertex_channel, std::move(id), std::move(label), std::move(help), {},
+              std::string(Options{}.*field));
+    state_->setters.push_back(
+        [field, key = op_.params.back().id](Options& o, const ParamValues& v) { o.*field = v.get_text(key); });
+    return *this;
+  }
+
   //! An option every catalogue run sets to `value`, not shown to users (e.g. no backup copy:
   //! run_operation's mesh is built for the run and dropped on failure).
   template <class T>

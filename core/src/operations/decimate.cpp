@@ -53,6 +53,12 @@ struct Quadric {
     return *this;
   }
   friend Quadric operator+(Quadric a, const Quadric& b) { return a += b; }
+  //! Every plane's weight times f.
+  Quadric& operator*=(double f) {
+    a00 *= f, a01 *= f, a02 *= f, a11 *= f, a12 *= f, a22 *= f;
+    g0 *= f, g1 *= f, g2 *= f, k *= f, weight *= f;
+    return *this;
+  }
 
   Vec3d times(const Vec3d& u) const {
     return {{a00 * u[0] + a01 * u[1] + a02 * u[2], a01 * u[0] + a11 * u[1] + a12 * u[2],
@@ -220,14 +226,17 @@ struct Candidate {
 // vertex may do with respect to seams of per-corner attributes: kOnSeam when a seam edge
 // touches it, kSeamLine when it lies inside one seam (it may slide along it), kLockedSeam
 // for seam ends, junctions and seams meeting the boundary (it stays).
-// kLocked: with selection_only, a vertex with a face outside the selection; it neither moves
-// nor goes, so those faces stay as they were.
+// kLocked: with selection_only, a vertex with a face outside the selection (so those faces
+// stay as they were), or a vertex the lock attribute marks; it neither moves nor goes.
 enum VertexFlag : std::uint8_t { kBoundary = 1, kOnSeam = 2, kSeamLine = 4, kLockedSeam = 8, kLocked = 16 };
 constexpr std::uint8_t kSeamBits = kOnSeam | kSeamLine | kLockedSeam;
 
 // Boundary edges add a plane through the edge, perpendicular to its face, so moving a
 // boundary vertex off the boundary's line costs (Garland & Heckbert's boundary constraint).
 constexpr double kBoundaryWeight = 10;
+
+// Quadrics are stored in floats: a weight far beyond this would only blur their precision.
+constexpr double kMaxWeightStrength = 1000;
 
 // Pull of the optimal placement towards the edge's midpoint, relative to the quadric's mean
 // eigenvalue. 1% keeps new vertices inside their neighbourhood in flat and cylindrical
@@ -246,6 +255,7 @@ class Decimator {
   // ---- setup -------------------------------------------------------------------------
   void triangulate_polygons();
   void compute_frame();
+  void read_weights_and_locks();
   void compute_quadrics();
   void find_corner_channels();
   void classify_vertices();
@@ -341,6 +351,8 @@ class Decimator {
   double cos_max_normal_change_ = 0;
   bool seam_mode_ = false;
   std::vector<std::uint8_t> inside_selection_;  // per vertex, with selection_only (selection.h)
+  std::vector<double> weight_factor_;           // per vertex, 1 + strength * weight (weight_attribute)
+  std::vector<double> lock_;                    // per vertex, non-zero when locked (lock_attribute)
   bool has_boundary_ = false;
 
   // Everything evaluate() reads about a vertex, in one cache line: its quadric (about its
@@ -422,6 +434,30 @@ void Decimator::compute_frame() {
   inv_scale_ = 1 / scale_;
 }
 
+void Decimator::read_weights_and_locks() {
+  if (!opt_.lock_attribute.empty()) {
+    lock_ = detail::vertex_values(m_, opt_.lock_attribute, "decimate: lock_attribute");
+    for (Vertex v : m_.vertices()) report_.locked_vertices += lock_[v.idx()] != 0;
+  }
+  if (opt_.weight_attribute.empty()) return;
+  std::vector<double> w = detail::vertex_values(m_, opt_.weight_attribute, "decimate: weight_attribute");
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (Vertex v : m_.vertices())
+    if (std::isfinite(w[v.idx()])) lo = std::min(lo, w[v.idx()]), hi = std::max(hi, w[v.idx()]);
+  // Vertex groups hold 0 to 1; other attributes (MeshLab's quality, a curvature) any range,
+  // which only their spread can turn into weights.
+  const bool rescale = lo < 0 || hi > 1;
+  if (rescale)
+    report_.messages.push_back("weight_attribute '" + opt_.weight_attribute + "' runs from " + std::to_string(lo) +
+                               " to " + std::to_string(hi) + ": rescaled to 0 to 1 as weights");
+  weight_factor_.assign(w.size(), 1);
+  for (Vertex v : m_.vertices()) {
+    double x = std::isfinite(w[v.idx()]) ? w[v.idx()] : 0;
+    if (rescale) x = hi > lo ? (x - lo) / (hi - lo) : 0;
+    weight_factor_[v.idx()] = 1 + opt_.weight_strength * std::clamp(x, 0.0, 1.0);
+  }
+}
+
 void Decimator::compute_quadrics() {
   const std::size_t n = m_.vertices_size();
   vd_.clear();
@@ -472,8 +508,13 @@ void Decimator::compute_quadrics() {
       for (Vertex v : {a, b})
         if (mine(v)) sum[v.idx() - begin].add_plane(normal, dot(normal, at(v) - pa), kBoundaryWeight * sqrnorm(along));
     }
-    for (std::size_t i = begin; i < end; ++i)
-      if (!m_.is_deleted(Vertex(static_cast<Index>(i)))) vd_[i].quadric.store(sum[i - begin]);
+    for (std::size_t i = begin; i < end; ++i) {
+      if (m_.is_deleted(Vertex(static_cast<Index>(i)))) continue;
+      // A weight scales every plane of the vertex, and so its share of a merged quadric: the
+      // cost rises where detail matters while cost / weight stays a mean squared distance.
+      if (!weight_factor_.empty()) sum[i - begin] *= weight_factor_[i];
+      vd_[i].quadric.store(sum[i - begin]);
+    }
   });
   has_boundary_ = has_boundary.load();
 }
@@ -529,6 +570,7 @@ void Decimator::classify_vertices() {
       std::uint8_t f = m_.is_boundary(v) ? kBoundary : 0;
       if (seam_mode_) f |= classify(v);
       if (!inside_selection_.empty() && !inside_selection_[i]) f |= kLocked;
+      if (!lock_.empty() && lock_[i] != 0) f |= kLocked;
       vd_[i].flags = f;
     }
   });
@@ -1099,6 +1141,7 @@ DecimateReport Decimator::run() {
   cos_max_normal_change_ = std::cos(std::min(opt_.max_normal_change_degrees, 90.0) * std::numbers::pi / 180);
 
   progress_.update(0, "preparing");
+  read_weights_and_locks();  // first: a name the mesh lacks leaves it untouched
   triangulate_polygons();
   faces_ = m_.n_faces();
   // The faces the ratio applies to: all, or the selected ones (the rest stay).
@@ -1242,6 +1285,9 @@ void check_options(const DecimateOptions& o) {
   if (!(o.max_normal_change_degrees >= 0 && o.max_normal_change_degrees <= 90))
     throw Error("decimate: max_normal_change_degrees must be from 0 to 90, got " +
                 std::to_string(o.max_normal_change_degrees));
+  if (!(o.weight_strength >= 0 && o.weight_strength <= kMaxWeightStrength))
+    throw Error("decimate: weight_strength must be a number from 0 to " + std::to_string(int(kMaxWeightStrength)) +
+                ", got " + std::to_string(o.weight_strength));
   if (o.target_faces > std::size_t(std::numeric_limits<Index>::max()))
     throw Error("decimate: target_faces is larger than any mesh can be");
 }
@@ -1299,6 +1345,16 @@ Operation decimate_operation() {
       .selection(&O::selection_only,
                  "Only the selected faces are simplified, the target ratio applying to them; faces outside "
                  "the selection stay as they are, and so does the border between the two.")
+      .vertex_channel(&O::weight_attribute, "weight_attribute", "Weight attribute",
+                      "A vertex attribute saying where detail matters (Blender: a vertex group; MeshLab: "
+                      "quality): a vertex of weight w counts its error 1 + strength x w times, so weighted "
+                      "regions keep more triangles. Weights run from 0 to 1; other ranges are rescaled. Empty: "
+                      "none.")
+      .option(&O::weight_strength, "weight_strength", "Weight strength", between(0, kMaxWeightStrength),
+              "How much a weight of 1 protects a vertex: its error counts 1 + this many times.")
+      .vertex_channel(&O::lock_attribute, "lock_attribute", "Lock attribute",
+                      "A vertex attribute (Blender: a vertex group) whose non-zero vertices are locked: they "
+                      "neither move nor go. Empty: none.")
       .result(&R::faces_before, "faces_before")
       .result(&R::faces_after, "faces_after")
       .result(&R::vertices_before, "vertices_before")
@@ -1307,7 +1363,13 @@ Operation decimate_operation() {
       .result(&R::collapses, "collapses")
       .result(&R::triangulated_faces, "triangulated_faces")
       .result(&R::max_error, "max_error")
-      .result(&R::stopped_by, "stopped_by");
+      .result("locked_vertices",
+              [](const O& o, const R& r) -> std::optional<Value> {
+                if (o.lock_attribute.empty()) return std::nullopt;
+                return field_value(r.locked_vertices);
+              })
+      .result(&R::stopped_by, "stopped_by")
+      .messages(&R::messages);
 }
 
 }  // namespace hedge
