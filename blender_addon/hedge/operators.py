@@ -21,7 +21,7 @@ def reap_abandoned():
 
 # What the Blender exchange carries and does not, said in every tooltip of a changing operation.
 EXCHANGE_NOTE = ("Shape keys follow: each key is carried as its offset from the basis (the reference key), "
-                 "interpolated like an attribute, and rebuilt as the new basis plus that offset, so keys "
+                 "interpolated like an attribute (decimation measures its error in every key too), and rebuilt as the new basis plus that offset, so keys "
                  "relative to other keys and absolute keys deform as before; the same keys stay, with their "
                  "names, order, settings, drivers and animation. Not carried when the connectivity changes: "
                  "custom split normals, loose edges. Vertex group weights are interpolated (weight 0 leaves "

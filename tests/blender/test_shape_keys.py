@@ -207,22 +207,23 @@ class ShapeKeysTest(unittest.TestCase):
         return figures
 
     def test_decimated_dent_within_the_decimation_error(self):
-        # The issue's case: Blender's default UV sphere (32 x 16), decimated to 25 %. The key's
-        # vertices lie on the dented sphere about as closely as the basis's lie on the sphere;
-        # the faces between them were chosen for the sphere, so the dented surface is further.
+        # The issue's case: Blender's default UV sphere (32 x 16), decimated to 25 %. Collapses
+        # are measured in every key too (the "shape:" channels' quadrics), so the key's vertices
+        # lie on the dented sphere as closely as the basis's lie on the sphere, and the faces
+        # between them suit both.
         figures = self.decimate_and_measure(32, 16, 0.25)
         self.assertGreater(figures["basis"], 0)
-        self.assertLessEqual(figures["dent"], 1.5 * figures["basis"], "the dent is worse than the decimation's own error")
-        self.assertLessEqual(figures["dent_surface"], 3 * figures["basis_surface"])
+        self.assertLessEqual(figures["dent"], 1.05 * figures["basis"], "the dent is worse than the decimation's own error")
+        self.assertLessEqual(figures["dent_surface"], 1.25 * figures["basis_surface"])
         self.assertGreater(figures["lost"], 10 * figures["dent"])
 
     def test_decimated_dent_on_finer_spheres(self):
-        # Each collapse interpolates the offsets in the triangles of the mesh decimated so far
-        # (the positions' quadrics remember the original surface; the offsets do not), so the
-        # key drifts further from its surface than the basis, the more so the more collapses.
+        # The placement follows the basis's quadric alone, so with many collapses the key's
+        # vertices may drift a little further from their surface than the basis's.
         for segments, rings, ratio in ((32, 16, 0.1), (64, 32, 0.25), (64, 32, 0.1)):
             figures = self.decimate_and_measure(segments, rings, ratio)
-            self.assertLessEqual(figures["dent"], 3.5 * figures["basis"], (segments, ratio))
+            self.assertLessEqual(figures["dent"], 1.3 * figures["basis"], (segments, ratio))
+            self.assertLessEqual(figures["dent_surface"], 2 * figures["basis_surface"], (segments, ratio))
             self.assertGreater(figures["lost"], 3 * figures["dent"], (segments, ratio))
 
     def test_every_operation_keeps_every_key(self):

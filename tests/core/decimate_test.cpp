@@ -665,6 +665,51 @@ TEST(Decimate, WeightsAndLocksThroughTheCatalogue) {
   EXPECT_EQ(plain.report.find("locked_vertices"), nullptr);
 }
 
+// ---- shapes ---------------------------------------------------------------------------------
+
+// The mesh as it looks in the shape of channel `name` (positions plus offsets).
+Mesh in_shape(const Mesh& mesh, const std::string& name) {
+  Soup s = extract(mesh);
+  const Channel* offsets = s.find(name, Domain::vertex);
+  for (std::size_t i = 0; i < s.n_vertices(); ++i)
+    for (int j = 0; j < 3; ++j) s.positions[i][j] += offsets->as<float>()[3 * i + j];
+  return build(s).mesh;
+}
+
+TEST(Decimate, ShapesWeighInTheError) {
+  // A sphere with a shape that dents it deeply where the sphere itself is smooth: the dent
+  // only survives decimation when collapses are measured in that shape too. The same offsets
+  // in a channel without the "shape:" prefix are only interpolated, not measured.
+  auto dented_sphere = [](const std::string& name) {
+    Soup s = icosphere(5);
+    float* o = s.add_channel(name, Domain::vertex, ScalarType::f32, 3).as<float>();
+    for (std::size_t i = 0; i < s.n_vertices(); ++i) {
+      const Vec3d p = to_double(s.positions[i]);
+      const double depth = 0.4 * std::exp(-sqrnorm(p - Vec3d{{1, 0, 0}}) / 0.08);
+      for (int j = 0; j < 3; ++j) o[3 * i + j] = static_cast<float>(-depth * p[j]);
+    }
+    return build(s).mesh;
+  };
+  DecimateOptions o;
+  o.target_ratio = 0.05;
+  std::map<std::string, std::pair<double, double>> error;  // basis, dented shape
+  for (const std::string name : {"shape:dent", "offsets"}) {
+    const Mesh input = dented_sphere(name);
+    Mesh mesh = input;
+    const DecimateReport r = decimate(mesh, o);
+    expect_clean(mesh);
+    EXPECT_EQ(r.stopped_by, "target reached");
+    error[name] = {hausdorff(input, mesh).max, hausdorff(in_shape(input, name), in_shape(mesh, name)).max};
+  }
+  const auto [basis, weighed] = error["shape:dent"];
+  const auto [basis_carried, carried] = error["offsets"];
+  std::printf("to 5 %%, Hausdorff: basis %.4f, dented shape %.4f; offsets only carried: basis %.4f, dented %.4f\n",
+              basis, weighed, basis_carried, carried);
+  EXPECT_LT(weighed, 0.4 * carried);
+  EXPECT_LT(weighed, 2.5 * basis);
+  EXPECT_LT(basis, 1.5 * basis_carried);  // the shape costs the basis little
+}
+
 // ---- contracts -----------------------------------------------------------------------------
 
 TEST(Decimate, Deterministic) {

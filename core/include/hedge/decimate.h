@@ -81,7 +81,11 @@ struct DecimateReport {
 //! Simplification Using Quadric Error Metrics", SIGGRAPH 1997), placing the new vertex at
 //! the quadric's minimum (over the edge when that is singular). Polygons are triangulated
 //! first. Vertex properties are interpolated at the new vertex; per-corner properties are
-//! interpolated per wedge (Hoppe 1999), so UV charts stay continuous. Hits the target
+//! interpolated per wedge (Hoppe 1999), so UV charts stay continuous. Other shapes of the
+//! mesh ("shape:" vertex channels, soup.h) weigh in: each vertex also has a quadric of its
+//! faces in each shape, a collapse costs the sum of its errors in all of them (placed by the
+//! mesh's own quadric, its offsets blended like attributes), and the error reported and
+//! compared with max_error is the mean over the shapes. Hits the target
 //! exactly when the topology allows it: an interior collapse removes two triangles, a
 //! boundary one removes one, so on closed surfaces an odd target stops one triangle above.
 //! Throws Error on bad options, leaving the mesh untouched; when cancelled through

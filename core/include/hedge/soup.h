@@ -28,9 +28,13 @@ struct Channel {
   std::size_t count() const { return stride() ? data.size() / stride() : 0; }
 
   template <class T>
-  T* as() { return reinterpret_cast<T*>(data.data()); }
+  T* as() {
+    return reinterpret_cast<T*>(data.data());
+  }
   template <class T>
-  const T* as() const { return reinterpret_cast<const T*>(data.data()); }
+  const T* as() const {
+    return reinterpret_cast<const T*>(data.data());
+  }
   //! A channel of n elements, zero-filled.
   static Channel make(std::string name, Domain domain, ScalarType scalar, int components, std::size_t n);
 
@@ -44,6 +48,9 @@ struct Channel {
 //   "quality"  f32 x1  vertex or face
 //   "selected" u8 x1   vertex or face
 //   "material" i32 x1  face
+//   "shape:<name>" f32 x3  vertex: the vertex's offset in another shape of the same mesh
+//                  (Blender's shape keys); decimation weighs the error in each shape too
+inline constexpr const char* kShapePrefix = "shape:";
 
 //! Polygons over indexed vertices. Face f has face_sizes[f] corners; its corner vertex
 //! indices are corners[offset(f) .. offset(f) + face_sizes[f]).

@@ -256,7 +256,10 @@ class Decimator {
   void triangulate_polygons();
   void compute_frame();
   void read_weights_and_locks();
+  void find_shapes();
   void compute_quadrics();
+  template <class Where>
+  void add_face_planes(std::vector<Quadric>& sum, std::size_t begin, std::size_t end, Where where) const;
   void find_corner_channels();
   void classify_vertices();
   //! Lets collapses meet extract()'s weld of build()'s copies from now on; false when they
@@ -273,6 +276,18 @@ class Decimator {
   Vec3d local(Vertex v) const { return (to_double(m_.position(v)) - center_) * inv_scale_; }
   Vec3d at(Vertex v) const { return to_double(vd_[v.idx()].position); }
   Point world(const Vec3d& p) const { return to_float(center_ + p * scale_); }
+  // Shapes: the offset of v in shape k, and v's place there, in the normalized frame.
+  Vec3d shape_offset(std::size_t k, Vertex v) const {
+    float o[3];
+    std::memcpy(o, shapes_[k]->element(v.idx()), sizeof o);
+    return Vec3d{{o[0], o[1], o[2]}} * inv_scale_;
+  }
+  Vec3d shape_at(std::size_t k, Vertex v) const { return at(v) + shape_offset(k, v); }
+  Quadric shape_quadric(std::size_t k, Vertex v) const {
+    return shape_quadrics_[v.idx() * shapes_.size() + k].unpack();
+  }
+  double shapes_cost(Vertex a, Vertex b, const Vec3d& p, double s) const;
+  double shapes_weight(Vertex a, Vertex b) const;
   bool corners_equal(Halfedge a, Halfedge b) const {
     for (const ChannelArray* c : corner_channels_)
       if (std::memcmp(c->element(a.idx()), c->element(b.idx()), c->stride()) != 0) return false;
@@ -353,6 +368,11 @@ class Decimator {
   std::vector<std::uint8_t> inside_selection_;  // per vertex, with selection_only (selection.h)
   std::vector<double> weight_factor_;           // per vertex, 1 + strength * weight (weight_attribute)
   std::vector<double> lock_;                    // per vertex, non-zero when locked (lock_attribute)
+  // The mesh's other shapes (soup.h: "shape:" channels, e.g. Blender's shape keys), and a
+  // quadric per vertex and shape about the vertex's place in that shape, vertex-major.
+  std::vector<const ChannelArray*> shapes_;
+  std::vector<PackedQuadric> shape_quadrics_;
+  std::vector<Vec3d> shape_before_;  // scratch of collapse(): both ends' places in each shape
   bool has_boundary_ = false;
 
   // Everything evaluate() reads about a vertex, in one cache line: its quadric (about its
@@ -476,20 +496,7 @@ void Decimator::compute_quadrics() {
   parallel_for(n, opt_.threads, [&](std::size_t begin, std::size_t end) {
     std::vector<Quadric> sum(end - begin);
     auto mine = [&](Vertex v) { return v.idx() - begin < end - begin; };
-    // Face planes weighted by area, so that a region's error does not depend on how finely
-    // it happens to be tessellated.
-    for (Face f : m_.faces()) {
-      const Halfedge h = m_.halfedge(f);
-      const Vertex a = m_.to_vertex(h), b = m_.to_vertex(m_.next(h)), c = m_.to_vertex(m_.prev(h));
-      if (!mine(a) && !mine(b) && !mine(c)) continue;
-      const Vec3d pa = at(a), pb = at(b), pc = at(c);
-      Vec3d normal = cross(pb - pa, pc - pa);
-      const double len = norm(normal);
-      if (!(len > 0)) continue;
-      normal /= len;
-      for (Vertex v : {a, b, c})
-        if (mine(v)) sum[v.idx() - begin].add_plane(normal, dot(normal, at(v) - pa), 0.5 * len);
-    }
+    add_face_planes(sum, begin, end, [&](Vertex v) { return at(v); });
     for (Edge e : m_.edges()) {
       Halfedge h = Mesh::halfedge(e, 0);
       if (!m_.is_boundary(h)) h = Mesh::opposite(h);
@@ -515,8 +522,70 @@ void Decimator::compute_quadrics() {
       if (!weight_factor_.empty()) sum[i - begin] *= weight_factor_[i];
       vd_[i].quadric.store(sum[i - begin]);
     }
+    // Each shape's faces, as the mesh's own (its boundary is held by the mesh's quadrics).
+    for (std::size_t k = 0; k < shapes_.size(); ++k) {
+      std::fill(sum.begin(), sum.end(), Quadric());
+      add_face_planes(sum, begin, end, [&](Vertex v) { return shape_at(k, v); });
+      for (std::size_t i = begin; i < end; ++i) {
+        if (!weight_factor_.empty()) sum[i - begin] *= weight_factor_[i];
+        shape_quadrics_[i * shapes_.size() + k].store(sum[i - begin]);
+      }
+    }
   });
   has_boundary_ = has_boundary.load();
+}
+
+// Face planes weighted by area, so that a region's error does not depend on how finely it
+// happens to be tessellated; each vertex's quadric is about its own place (where(v)).
+template <class Where>
+void Decimator::add_face_planes(std::vector<Quadric>& sum, std::size_t begin, std::size_t end, Where where) const {
+  auto mine = [&](Vertex v) { return v.idx() - begin < end - begin; };
+  for (Face f : m_.faces()) {
+    const Halfedge h = m_.halfedge(f);
+    const Vertex a = m_.to_vertex(h), b = m_.to_vertex(m_.next(h)), c = m_.to_vertex(m_.prev(h));
+    if (!mine(a) && !mine(b) && !mine(c)) continue;
+    const Vec3d pa = where(a), pb = where(b), pc = where(c);
+    Vec3d normal = cross(pb - pa, pc - pa);
+    const double len = norm(normal);
+    if (!(len > 0)) continue;
+    normal /= len;
+    for (Vertex v : {a, b, c})
+      if (mine(v)) sum[v.idx() - begin].add_plane(normal, dot(normal, where(v) - pa), 0.5 * len);
+  }
+}
+
+void Decimator::find_shapes() {
+  const PropertyContainer& vp = m_.vertex_properties();
+  for (std::size_t i = 0; i < vp.count(); ++i) {
+    const PropertyArray& a = vp.at(i);
+    if (a.type() != typeid(ChannelArray) || !a.name().starts_with(kShapePrefix)) continue;
+    const auto& c = static_cast<const ChannelArray&>(a);
+    if (c.scalar() == ScalarType::f32 && c.components() == 3) shapes_.push_back(&c);
+  }
+  shape_quadrics_.resize(shapes_.size() * m_.vertices_size());
+  shape_before_.resize(2 * shapes_.size());
+}
+
+// The error of a collapse in the other shapes: the merged vertex at p (relative to a) takes
+// the offsets (1 - s) of a's and s of b's, as its attributes are blended along the edge.
+double Decimator::shapes_cost(Vertex a, Vertex b, const Vec3d& p, double s) const {
+  double cost = 0;
+  for (std::size_t k = 0; k < shapes_.size(); ++k) {
+    const Vec3d oa = shape_offset(k, a), ob = shape_offset(k, b);
+    const Vec3d ab = at(b) + ob - at(a) - oa;  // b relative to a, in shape k
+    const Quadric q = shape_quadric(k, a) + shape_quadric(k, b).shifted(-ab);
+    cost += q(p + (ob - oa) * s);
+  }
+  return cost;
+}
+
+double Decimator::shapes_weight(Vertex a, Vertex b) const {
+  double w = 0;
+  for (std::size_t k = 0; k < shapes_.size(); ++k) {
+    w += double(shape_quadrics_[a.idx() * shapes_.size() + k].weight);
+    w += double(shape_quadrics_[b.idx() * shapes_.size() + k].weight);
+  }
+  return w;
 }
 
 void Decimator::find_corner_channels() {
@@ -677,6 +746,7 @@ bool Decimator::evaluate(Edge e, Candidate& c) const {
       cost = q(p);
     }
     if (touches_boundary) cost += boundary_weight * boundary_shift(h0, pa + p);
+    if (!shapes_.empty()) cost += shapes_cost(a, b, p, remove_a ? t : 1 - t);
     c.position = world(pa + p);
     c.cost = static_cast<float>(cost);
     c.kept_weight = static_cast<float>(t);
@@ -689,6 +759,10 @@ bool Decimator::evaluate(Edge e, Candidate& c) const {
   if (touches_boundary) {
     if (ra) cost_keep_b += boundary_weight * boundary_shift(h0, pb);
     if (rb) cost_keep_a += boundary_weight * boundary_shift(h0, pa);
+  }
+  if (!shapes_.empty()) {
+    if (ra) cost_keep_b += shapes_cost(a, b, ab, 1);
+    if (rb) cost_keep_a += shapes_cost(a, b, Vec3d{}, 0);
   }
   const bool keep_b = cost_keep_b <= cost_keep_a;
   c.position = m_.position(keep_b ? b : a);
@@ -1102,8 +1176,18 @@ void Decimator::collapse(Halfedge h, const Candidate& c) {
   const Vec3d c0 = to_double(d0.position), c1 = to_double(d1.position);
   const Vec3d moved = local(v1);
   d1.quadric.store((d1.quadric.unpack() + d0.quadric.unpack().shifted(c1 - c0)).shifted(moved - c1));
+  for (std::size_t k = 0; k < shapes_.size(); ++k) {
+    shape_before_[2 * k] = shape_at(k, v0);
+    shape_before_[2 * k + 1] = shape_at(k, v1);
+  }
   d1.position = to_float(moved);
   interpolate_vertex(v0, v1, c);
+  // Each shape's merged quadric, about the new vertex's place there (its blended offset).
+  for (std::size_t k = 0; k < shapes_.size(); ++k) {
+    const Vec3d k0 = shape_before_[2 * k], k1 = shape_before_[2 * k + 1];
+    PackedQuadric& q1 = shape_quadrics_[v1.idx() * shapes_.size() + k];
+    q1.store((q1.unpack() + shape_quadric(k, v0).shifted(k1 - k0)).shifted(shape_at(k, v1) - k1));
+  }
   if (!corner_channels_.empty()) blend_wedges(v1);
 
   d1.valence = static_cast<std::uint16_t>(d0.valence + d1.valence - 2 - removed_faces);
@@ -1166,6 +1250,7 @@ DecimateReport Decimator::run() {
   }
 
   compute_frame();
+  find_shapes();
   compute_quadrics();
   find_corner_channels();
   classify_vertices();
@@ -1215,7 +1300,8 @@ DecimateReport Decimator::run() {
     const Halfedge h = Mesh::halfedge(e, c.side);
     const PackedQuadric& q0 = vd_[m_.from_vertex(h).idx()].quadric;
     const PackedQuadric& q1 = vd_[m_.to_vertex(h).idx()].quadric;
-    const double weight = double(q0.weight) + double(q1.weight);
+    double weight = double(q0.weight) + double(q1.weight);
+    if (!shapes_.empty()) weight += shapes_weight(m_.from_vertex(h), m_.to_vertex(h));
     const double error_sq = weight > 0 ? double(c.cost) / weight : 0;
     if (max_error_sq > 0 && error_sq > max_error_sq) {
       refused_for_error_ = true;
@@ -1316,9 +1402,10 @@ Operation decimate_operation() {
       "vertex; per-corner attributes such as UVs are interpolated per wedge and kept continuous across seams "
       "(after Hoppe 1999), and vertices on a seam only slide along it. Boundaries stay in place by default, no "
       "triangle is flipped, and the topology never changes: holes, handles and components stay, so a mesh full "
-      "of small pieces and slits may stop above its target. Attributes do not weigh in the error (a UV seam or "
-      "colour edge is kept by the seam rules, not by the metric), and creases get no special treatment beyond "
-      "what the quadrics give them.";
+      "of small pieces and slits may stop above its target. Shape keys weigh in the error: each collapse is "
+      "measured in every key too, so a key's shape is kept as well as the mesh's. Other attributes do not (a UV "
+      "seam or colour edge is kept by the seam rules, not by the metric), and creases get no special treatment "
+      "beyond what the quadrics give them.";
   using O = DecimateOptions;
   using R = DecimateReport;
   return Binding<O, R>("decimate", "Decimate", Category::remeshing, help, decimate)
