@@ -184,10 +184,12 @@ void refine_vertices(const Mesh& m, Mesh& out, const VertexRule& rule, unsigned 
       for (std::size_t v = lo; v < hi; ++v) {
         s.clear();
         even(Vertex(Index(v)), s);
-        if (positions) p[v] = position(s);
+        // A vertex that stays is copied, bit for bit (a blend would turn -0 into +0).
+        const bool stays = s.size() == 1 && s.index(0) == v && s.weight(0) == 1.0f;
+        if (positions) p[v] = stays ? old_p[v] : position(s);
         if (properties)
           for (const Target& x : all) {
-            if (x.internal)
+            if (x.internal || stays)
               x.array->copy_element(v, V + N + v);
             else
               blend(x, V + N + v, s.index(), s.weight());
