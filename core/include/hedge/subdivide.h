@@ -107,6 +107,8 @@ std::size_t subdivided_face_count(const Mesh& mesh, const SubdivideOptions& opti
 //!   and creases between selected faces, never a border edge. So along the border the
 //!   triangles keep the old edge, as along a boundary on odd steps, on every step.
 //! Children of a selected face stay selected, so later iterations refine the same region.
+//! The pieces along the border keep its whole edges while the selection around them shrinks,
+//! so over several iterations they grow long and thin: the price of a border that stays.
 //! loop and sqrt3 need only the selected faces to be triangles. Nothing selected: the mesh is
 //! returned unchanged.
 //!
