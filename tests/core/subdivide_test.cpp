@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -456,8 +457,9 @@ TEST(Subdivide, FaceVisitingAVertexTwiceGivesNoDuplicate) {
   soup.face_sizes = {4, 3};
   for (auto s : {SubdivisionScheme::midpoint, SubdivisionScheme::catmull_clark}) {
     const Operation& op = find_operation("subdivide");
-    const RunResult result =
-        run_operation(op, soup, resolve_params(op, std::map<std::string, std::string>{{"scheme", subdivision_scheme_name(s)}}), Progress::none());
+    const RunResult result = run_operation(
+        op, soup, resolve_params(op, std::map<std::string, std::string>{{"scheme", subdivision_scheme_name(s)}}),
+        Progress::none());
     std::set<std::vector<std::uint32_t>> sets;
     const auto offsets = result.soup.face_offsets();
     for (std::size_t f = 0; f < result.soup.n_faces(); ++f) {
@@ -1200,6 +1202,475 @@ TEST(Subdivide, DragonLoopTiming) {
               dragon.n_faces(), mesh.n_faces(), best, best_cpu);
   EXPECT_EQ(mesh.n_faces(), 4 * dragon.n_faces());
   expect_valid(mesh);
+}
+
+// ---- selection_only --------------------------------------------------------------------------
+
+//! Marks the faces for which `pick(centroid)` holds as selected (the "selected" face channel).
+template <class Pick>
+std::size_t select_faces(Mesh& mesh, Pick pick) {
+  ChannelArray* channel = mesh.face_properties().get_channel("selected");
+  if (!channel) channel = mesh.face_properties().add_channel("selected", ScalarType::u8, 1);
+  std::size_t count = 0;
+  for (Face f : mesh.faces()) {
+    Vec3d centre{};
+    for (Vertex v : mesh.vertices(f)) centre += to_double(mesh.position(v));
+    const std::uint8_t on = pick(centre * (1.0 / double(mesh.valence(f)))) ? 1 : 0;
+    *reinterpret_cast<std::uint8_t*>(channel->element(f.idx())) = on;
+    count += on;
+  }
+  return count;
+}
+
+bool is_selected(const Mesh& mesh, Face f) {
+  const ChannelArray* channel = mesh.face_properties().get_channel("selected");
+  return channel && *reinterpret_cast<const std::uint8_t*>(channel->element(f.idx())) != 0;
+}
+
+using Corners = std::vector<std::array<float, 3>>;
+
+//! The faces with selection flag `want`, each as its corner positions in order from the
+//! smallest one on, sorted: what the host sees of them whatever the numbering.
+std::vector<Corners> faces_where(const Mesh& mesh, bool want) {
+  std::vector<Corners> out;
+  for (Face f : mesh.faces()) {
+    if (is_selected(mesh, f) != want) continue;
+    Corners c;
+    for (Vertex v : mesh.vertices(f)) c.push_back({mesh.position(v)[0], mesh.position(v)[1], mesh.position(v)[2]});
+    std::rotate(c.begin(), std::min_element(c.begin(), c.end()), c.end());
+    out.push_back(c);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+//! Selects the faces left of the median vertex x: about half of a real mesh.
+std::size_t select_left_half(Mesh& mesh) {
+  std::vector<float> xs;
+  for (Vertex v : mesh.vertices()) xs.push_back(mesh.position(v)[0]);
+  std::nth_element(xs.begin(), xs.begin() + std::ptrdiff_t(xs.size() / 2), xs.end());
+  const double median = xs[xs.size() / 2];
+  return select_faces(mesh, [&](const Vec3d& c) { return c[0] < median; });
+}
+
+SubdivideOptions selection_only(SubdivisionScheme s, int iterations = 1) {
+  SubdivideOptions o = scheme(s, iterations);
+  o.selection_only = true;
+  return o;
+}
+
+//! What selection_only promises, checked on `after`, refined from `before` with options `o`.
+void expect_selection_contract(const Mesh& before, const Mesh& after, const SubdivideOptions& o) {
+  SCOPED_TRACE(std::string(subdivision_scheme_name(o.scheme)) + ", " + std::to_string(o.iterations) + " steps");
+  expect_valid(after);
+  // Unselected faces: the same corners in the same order, at bit-identical positions.
+  EXPECT_EQ(faces_where(after, false), faces_where(before, false));
+  // The selection grew by refinement.
+  EXPECT_GT(faces_where(after, true).size(), faces_where(before, true).size());
+  // No face repeats a vertex (a closure that wrapped around would).
+  for (Face f : after.faces()) {
+    std::vector<Index> corners;
+    for (Vertex v : after.vertices(f)) corners.push_back(v.idx());
+    std::sort(corners.begin(), corners.end());
+    ASSERT_EQ(std::adjacent_find(corners.begin(), corners.end()), corners.end()) << "face " << f.idx();
+  }
+  // Watertight where it was: no new hole, and every boundary edge lies on the input's boundary
+  // (a crack along the border would add boundary edges between the old boundary's vertices).
+  const TopologyStats t0 = topology_stats(before), t1 = topology_stats(after);
+  EXPECT_EQ(t1.boundary_loops, t0.boundary_loops);
+  EXPECT_EQ(t1.components, t0.components);
+  EXPECT_EQ(t1.euler_characteristic, t0.euler_characteristic);
+  // Old vertices keep their indices; those on an unselected face stay, bit for bit.
+  for (Vertex v : before.vertices()) {
+    bool on_unselected = false;
+    for (Face f : before.faces(v)) on_unselected = on_unselected || !is_selected(before, f);
+    if (on_unselected) {
+      EXPECT_EQ(std::memcmp(&after.position(v), &before.position(v), sizeof(Point)), 0) << "vertex " << v.idx();
+    }
+  }
+}
+
+//! Everything selected is the run without selection_only, element for element and bit for bit.
+void expect_same_mesh(const Mesh& a, const Mesh& b) {
+  ASSERT_EQ(a.vertices_size(), b.vertices_size());
+  ASSERT_EQ(a.edges_size(), b.edges_size());
+  ASSERT_EQ(a.faces_size(), b.faces_size());
+  EXPECT_EQ(std::memcmp(a.positions().data(), b.positions().data(), sizeof(Point) * a.positions().size()), 0);
+  for (Halfedge h : a.halfedges()) {
+    ASSERT_EQ(a.to_vertex(h), b.to_vertex(h)) << "half-edge " << h.idx();
+    ASSERT_EQ(a.next(h), b.next(h)) << "half-edge " << h.idx();
+    ASSERT_EQ(a.face(h), b.face(h)) << "half-edge " << h.idx();
+  }
+  for (Face f : a.faces()) ASSERT_EQ(a.halfedge(f), b.halfedge(f));
+  for (Vertex v : a.vertices()) ASSERT_EQ(a.halfedge(v), b.halfedge(v));
+}
+
+const std::vector<SubdivisionScheme> kAllSchemes = {SubdivisionScheme::loop, SubdivisionScheme::catmull_clark,
+                                                    SubdivisionScheme::sqrt3, SubdivisionScheme::midpoint};
+const std::vector<SubdivisionScheme> kPolygonSchemes = {SubdivisionScheme::catmull_clark, SubdivisionScheme::midpoint};
+
+TEST(SubdivideSelection, HalfAGridKeepsTheOtherHalf) {
+  for (bool triangles : {true, false}) {
+    Mesh before = grid(6, triangles);
+    select_faces(before, [](const Vec3d& c) { return c[0] < 3.3; });
+    for (auto s : triangles ? kAllSchemes : kPolygonSchemes)
+      for (int iterations : {1, 2, 3}) {
+        Mesh mesh = before;
+        const SubdivideOptions o = selection_only(s, iterations);
+        const SubdivideReport r = subdivide(mesh, o);
+        expect_selection_contract(before, mesh, o);
+        EXPECT_EQ(r.faces, mesh.n_faces());
+        EXPECT_LE(mesh.n_faces(), subdivided_face_count(before, o));  // an upper bound
+        // Every face is selected or as it was: children of selected faces stay selected.
+        EXPECT_EQ(faces_where(mesh, false).size(), faces_where(before, false).size());
+      }
+  }
+}
+
+TEST(SubdivideSelection, BunnyHalfSelected) {
+  Mesh bunny = load("bunny.off");
+  if (bunny.is_empty()) GTEST_SKIP() << "bunny.off not found";
+  Mesh quads = bunny;
+  subdivide(quads, scheme(SubdivisionScheme::catmull_clark));
+  ASSERT_GT(select_left_half(bunny), bunny.n_faces() / 3);
+  ASSERT_GT(select_left_half(quads), quads.n_faces() / 3);
+  for (const Mesh* input : {&bunny, &quads})
+    for (auto s : input == &bunny ? kAllSchemes : kPolygonSchemes)
+      for (int iterations : {1, 2}) {
+        Mesh mesh = *input;
+        const SubdivideOptions o = selection_only(s, iterations);
+        subdivide(mesh, o);
+        expect_selection_contract(*input, mesh, o);
+        EXPECT_EQ(topology_stats(mesh).boundary_edges, topology_stats(*input).boundary_edges);
+        EXPECT_LE(mesh.n_faces(), subdivided_face_count(*input, o));
+        EXPECT_EQ(extract(mesh).n_faces(), mesh.n_faces());
+      }
+}
+
+TEST(SubdivideSelection, EverythingSelectedIsTheWholeRun) {
+  std::vector<std::pair<std::string, Mesh>> inputs = {
+      {"open grid", grid(4)}, {"quad grid", grid(4, false)}, {"cube", unit_cube()}, {"tetrahedron", tetrahedron()}};
+  if (Mesh bunny = load("bunny.off"); !bunny.is_empty()) inputs.emplace_back("bunny", std::move(bunny));
+  for (auto& [name, input] : inputs) {
+    select_faces(input, [](const Vec3d&) { return true; });
+    for (auto s : input.is_triangle_mesh() ? kAllSchemes : kPolygonSchemes)
+      for (int iterations : {1, 2}) {
+        SCOPED_TRACE(name + ", " + subdivision_scheme_name(s) + ", " + std::to_string(iterations) + " steps");
+        Mesh whole = input, selected = input;
+        subdivide(whole, scheme(s, iterations));
+        subdivide(selected, selection_only(s, iterations));
+        expect_same_mesh(selected, whole);
+        EXPECT_EQ(subdivided_face_count(input, selection_only(s, iterations)), whole.n_faces());
+      }
+  }
+}
+
+// The closures, face by face, on strips where the selected face has 0 to 3 split edges.
+TEST(SubdivideSelection, TrianglesClosedRedGreen) {
+  // A fan of triangles around vertex 0 on an open disc: selecting one triangle leaves its
+  // outer (boundary) edge split, its two spokes whole: 1 edge point, 2 triangles.
+  const Mesh fan = make_mesh({{{0, 0, 0}}, {{1, 0, 0}}, {{0, 1, 0}}, {{-1, 0, 0}}, {{0, -1, 0}}},
+                             {{0, 1, 2}, {0, 2, 3}, {0, 3, 4}, {0, 4, 1}});
+  for (auto s : {SubdivisionScheme::loop, SubdivisionScheme::midpoint}) {
+    Mesh mesh = fan;
+    select_faces(mesh, [](const Vec3d& c) { return c[0] > 0 && c[1] > 0; });
+    const Mesh before = mesh;
+    subdivide(mesh, selection_only(s));
+    expect_selection_contract(before, mesh, selection_only(s));
+    EXPECT_EQ(mesh.n_vertices(), 6u);
+    EXPECT_EQ(mesh.n_faces(), 3u + 2u);
+    // Two adjacent triangles selected: each has its boundary edge and the shared spoke split.
+    mesh = fan;
+    select_faces(mesh, [](const Vec3d& c) { return c[1] > 0; });
+    const Mesh two = mesh;
+    subdivide(mesh, selection_only(s));
+    expect_selection_contract(two, mesh, selection_only(s));
+    EXPECT_EQ(mesh.n_vertices(), 5u + 3u);
+    EXPECT_EQ(mesh.n_faces(), 2u + 3u + 3u);
+  }
+  // The quad c0 c1 m m' of a triangle with one whole edge is cut along its shorter diagonal:
+  // in a long flat triangle (0,0)-(10,0)-(0,1) with edge (0,0)-(10,0) whole, from (0,0) to the
+  // middle of the far edge, not from (10,0) across the whole length.
+  Mesh pair = make_mesh({{{0, 0, 0}}, {{10, 0, 0}}, {{0, 1, 0}}, {{5, -1, 0}}}, {{0, 1, 2}, {1, 0, 3}});
+  select_faces(pair, [](const Vec3d& c) { return c[1] > 0; });
+  subdivide(pair, selection_only(SubdivisionScheme::midpoint));
+  expect_valid(pair);
+  ASSERT_EQ(pair.n_faces(), 1u + 3u);
+  bool short_diagonal = false, long_diagonal = false;
+  for (Edge e : pair.edges()) {
+    const Vec3d a = to_double(pair.position(pair.vertex(e, 0))), b = to_double(pair.position(pair.vertex(e, 1)));
+    auto joins = [&](const Vec3d& p, const Vec3d& q) { return (a == p && b == q) || (a == q && b == p); };
+    short_diagonal = short_diagonal || joins({{0, 0, 0}}, {{5, 0.5, 0}});
+    long_diagonal = long_diagonal || joins({{10, 0, 0}}, {{0, 0.5, 0}});
+  }
+  EXPECT_TRUE(short_diagonal);
+  EXPECT_FALSE(long_diagonal);
+}
+
+TEST(SubdivideSelection, PolygonsClosedAroundTheirFacePoint) {
+  // A 3 x 3 grid of quads: the middle quad of the bottom row has its bottom edge on the
+  // boundary (split) and three whole edges: 1 edge point, a face point, 2 pieces.
+  const Mesh quads = grid(3, false);
+  for (auto s : kPolygonSchemes) {
+    Mesh mesh = quads;
+    select_faces(mesh, [](const Vec3d& c) { return c[0] > 1 && c[0] < 2 && c[1] < 1; });
+    const Mesh one = mesh;
+    subdivide(mesh, selection_only(s));
+    expect_selection_contract(one, mesh, selection_only(s));
+    EXPECT_EQ(mesh.n_vertices(), 16u + 2u);
+    EXPECT_EQ(mesh.n_faces(), 8u + 2u);
+    std::multiset<std::size_t> sizes;
+    for (Face f : mesh.faces())
+      if (is_selected(mesh, f)) sizes.insert(mesh.valence(f));
+    EXPECT_EQ(sizes, (std::multiset<std::size_t>{4, 5}));
+    // The centre quad of the 3 x 3 grid: no edge split, so it stays as it is.
+    mesh = quads;
+    select_faces(mesh, [](const Vec3d& c) { return c[0] > 1 && c[0] < 2 && c[1] > 1 && c[1] < 2; });
+    const Mesh centre = mesh;
+    subdivide(mesh, selection_only(s));
+    expect_valid(mesh);
+    EXPECT_EQ(faces_where(mesh, true), faces_where(centre, true));
+    EXPECT_EQ(mesh.n_vertices(), 16u);
+    // The left column: each quad has three split edges and one whole (its right side);
+    // every piece is a quad or, over the whole edge, a pentagon.
+    mesh = quads;
+    select_faces(mesh, [](const Vec3d& c) { return c[0] < 1; });
+    const Mesh column = mesh;
+    subdivide(mesh, selection_only(s));
+    expect_selection_contract(column, mesh, selection_only(s));
+    for (Face f : mesh.faces())
+      if (is_selected(mesh, f)) {
+        EXPECT_GE(mesh.valence(f), 4u);
+        EXPECT_LE(mesh.valence(f), 5u);
+      }
+  }
+  // A Catmull–Clark triangle with one split edge (its boundary edge; both spokes of the fan
+  // are whole): two quads through the opposite corner.
+  Mesh fan = make_mesh({{{0, 0, 0}}, {{1, 0, 0}}, {{0, 1, 0}}, {{-1, 0, 0}}, {{0, -1, 0}}},
+                       {{0, 1, 2}, {0, 2, 3}, {0, 3, 4}, {0, 4, 1}});
+  select_faces(fan, [](const Vec3d& c) { return c[0] > 0 && c[1] > 0; });
+  const Mesh before = fan;
+  subdivide(fan, selection_only(SubdivisionScheme::catmull_clark));
+  expect_selection_contract(before, fan, selection_only(SubdivisionScheme::catmull_clark));
+  EXPECT_EQ(fan.n_faces(), 3u + 2u);
+  for (Face f : fan.faces())
+    if (is_selected(fan, f)) {
+      EXPECT_EQ(fan.valence(f), 4u);
+    }
+}
+
+TEST(SubdivideSelection, AttributesFollowTheNormalRules) {
+  // uv = xy on a flat grid: midpoint subdivision is linear, so every corner of every piece
+  // (closures included) keeps uv = xy; faces keep their parent's material, and children of
+  // selected faces are selected.
+  Mesh mesh = grid_with_uv(4);
+  ChannelArray* material = mesh.face_properties().add_channel("material", ScalarType::i32, 1);
+  for (Face f : mesh.faces()) *reinterpret_cast<std::int32_t*>(material->element(f.idx())) = std::int32_t(f.idx());
+  select_faces(mesh, [](const Vec3d& c) { return c[0] + c[1] < 4; });
+  std::map<std::int32_t, std::uint8_t> parent_selected;
+  for (Face f : mesh.faces()) parent_selected[std::int32_t(f.idx())] = is_selected(mesh, f);
+  const Mesh before = mesh;
+  for (auto s : {SubdivisionScheme::midpoint, SubdivisionScheme::catmull_clark, SubdivisionScheme::sqrt3}) {
+    mesh = before;
+    subdivide(mesh, selection_only(s, 2));
+    expect_selection_contract(before, mesh, selection_only(s, 2));
+    const ChannelArray* uv = mesh.halfedge_properties().get_channel("uv");
+    material = mesh.face_properties().get_channel("material");
+    ASSERT_TRUE(uv && material);
+    for (Face f : mesh.faces()) {
+      const std::int32_t parent = *reinterpret_cast<const std::int32_t*>(material->element(f.idx()));
+      EXPECT_EQ(is_selected(mesh, f), parent_selected[parent] != 0);
+      for (Halfedge h : mesh.halfedges(f)) {
+        float value[2];
+        std::memcpy(value, uv->element(h.idx()), sizeof value);
+        const Point& p = mesh.position(mesh.to_vertex(h));
+        // Catmull–Clark and sqrt3 move the vertices inside the selection; uv stays linear.
+        if (s == SubdivisionScheme::midpoint) {
+          EXPECT_NEAR(value[0], p[0], 1e-5f);
+          EXPECT_NEAR(value[1], p[1], 1e-5f);
+        } else if (!is_selected(mesh, f)) {
+          EXPECT_EQ(value[0], p[0]);
+          EXPECT_EQ(value[1], p[1]);
+        }
+      }
+    }
+  }
+}
+
+TEST(SubdivideSelection, OnlySelectedFacesMustBeTriangles) {
+  // A pyramid: its quad base unselected, its triangles selected: loop and sqrt3 refine them.
+  const Mesh pyramid = make_mesh({{{0, 0, 0}}, {{1, 0, 0}}, {{1, 1, 0}}, {{0, 1, 0}}, {{0.5f, 0.5f, 1}}},
+                                 {{0, 3, 2, 1}, {0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}});
+  for (auto s : {SubdivisionScheme::loop, SubdivisionScheme::sqrt3})
+    for (int iterations : {1, 2}) {
+      Mesh mesh = pyramid;
+      select_faces(mesh, [](const Vec3d& c) { return c[2] > 0; });
+      const Mesh before = mesh;
+      subdivide(mesh, selection_only(s, iterations));
+      expect_selection_contract(before, mesh, selection_only(s, iterations));
+      EXPECT_EQ(topology_stats(mesh).boundary_loops, 0u);
+      // Selecting the base too is refused, and leaves the mesh.
+      mesh = pyramid;
+      select_faces(mesh, [](const Vec3d&) { return true; });
+      try {
+        subdivide(mesh, selection_only(s));
+        ADD_FAILURE() << "no error";
+      } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("1 selected face has more than 3 corners"), std::string::npos) << e.what();
+      }
+      EXPECT_EQ(mesh.n_faces(), 5u);
+    }
+}
+
+TEST(SubdivideSelection, NothingSelectedChangesNothing) {
+  for (bool with_channel : {false, true}) {
+    Mesh mesh = unit_cube();  // quads: loop would refuse them, but nothing is to be refined
+    if (with_channel) select_faces(mesh, [](const Vec3d&) { return false; });
+    const Mesh before = mesh;
+    const SubdivideReport r = subdivide(mesh, selection_only(SubdivisionScheme::loop, 2));
+    expect_same_mesh(mesh, before);
+    EXPECT_EQ(r.faces, 6u);
+    EXPECT_EQ(r.faces_before, 6u);
+    EXPECT_EQ(subdivided_face_count(before, selection_only(SubdivisionScheme::loop, 2)), 6u);
+  }
+  // Through the catalogue, the binding says so.
+  Soup soup = extract(unit_cube());
+  soup.add_channel("selected", Domain::face, ScalarType::u8, 1);
+  const Operation& op = find_operation("subdivide");
+  const RunResult result = run_operation(
+      op, soup, resolve_params(op, std::map<std::string, std::string>{{"selection_only", "true"}}), Progress::none());
+  EXPECT_EQ(result.soup.n_faces(), 6u);
+  EXPECT_NE(std::find(result.report.messages.begin(), result.report.messages.end(),
+                      "selection_only: nothing is selected, so the mesh is unchanged"),
+            result.report.messages.end());
+}
+
+TEST(SubdivideSelection, CreasesAndBoundariesInsideTheSelection) {
+  // An open grid with a fold, half selected: creases inside the selection keep their rules,
+  // the border holds; sqrt3's second step cuts only the selected part of the boundary.
+  for (bool triangles : {true, false}) {
+    Mesh before = folded_sheet(triangles);
+    select_faces(before, [](const Vec3d& c) { return c[1] < 1.5; });
+    for (auto s : triangles ? kAllSchemes : kPolygonSchemes)
+      for (int iterations : {1, 2}) {
+        Mesh mesh = before;
+        SubdivideOptions o = selection_only(s, iterations);
+        o.crease_angle = 30;
+        const SubdivideReport r = subdivide(mesh, o);
+        expect_selection_contract(before, mesh, o);
+        EXPECT_GT(r.crease_edges, 0u);
+        EXPECT_LE(mesh.n_faces(), subdivided_face_count(before, o));
+      }
+  }
+}
+
+// The two glued tetrahedra and the fin of SeamsOfNonManifoldInputStayClosed, through the
+// host pipeline (build, subdivide, extract): with one tetrahedron selected, the glued edge
+// has selected and unselected faces on its copies, so none of them is split and the weld
+// finds the five faces on one edge again; nothing else opens.
+TEST(SubdivideSelection, SplitNonManifoldEdgesStayWhole) {
+  Soup soup;
+  soup.positions = {{{0, 0, 0}}, {{1, 0, 0}}, {{0, 1, 0}}, {{0, 0, 1}}, {{0, -1, 0}}, {{0, 0, -1}}};
+  soup.positions.push_back({{0.5f, 0.5f, 0.5f}});
+  for (std::uint32_t c : {0, 2, 1, 0, 1, 3, 1, 2, 3, 2, 0, 3, 0, 4, 1, 0, 1, 5, 1, 4, 5, 4, 0, 5, 0, 1, 6})
+    soup.corners.push_back(c);
+  soup.face_sizes.assign(9, 3);
+  std::uint8_t* selected = soup.add_channel("selected", Domain::face, ScalarType::u8, 1).as<std::uint8_t>();
+  for (std::size_t f = 0; f < 4; ++f) selected[f] = 1;
+  const Operation& op = find_operation("subdivide");
+  for (auto s : kAllSchemes)
+    for (int iterations : {1, 2}) {
+      SCOPED_TRACE(std::string(subdivision_scheme_name(s)) + ", " + std::to_string(iterations) + " steps");
+      const RunResult r = run_operation(
+          op, soup,
+          resolve_params(op, std::map<std::string, std::string>{{"scheme", subdivision_scheme_name(s)},
+                                                                {"iterations", std::to_string(iterations)},
+                                                                {"selection_only", "true"}}),
+          Progress::none());
+      const Soup& out = r.soup;
+      std::map<std::pair<std::uint32_t, std::uint32_t>, int> faces_on_edge;
+      const auto offsets = out.face_offsets();
+      for (std::size_t f = 0; f < out.n_faces(); ++f)
+        for (std::uint32_t k = offsets[f]; k < offsets[f + 1]; ++k) {
+          const std::uint32_t a = out.corners[k], b = out.corners[k + 1 < offsets[f + 1] ? k + 1 : offsets[f]];
+          ++faces_on_edge[{std::min(a, b), std::max(a, b)}];
+        }
+      std::size_t open = 0, glued = 0, other = 0;
+      for (const auto& [edge, n] : faces_on_edge) {
+        open += n == 1;
+        glued += n == 5;
+        other += n != 1 && n != 2 && n != 5;
+      }
+      EXPECT_EQ(open, 2u);  // the fin's free sides, unselected
+      EXPECT_EQ(glued, 1u);
+      EXPECT_EQ(other, 0u);
+      EXPECT_GT(out.n_faces(), soup.n_faces());
+      // The unselected faces come back as they were.
+      const std::uint8_t* out_selected = out.find("selected", Domain::face)->as<std::uint8_t>();
+      std::multiset<std::vector<std::uint32_t>> kept;
+      for (std::size_t f = 0; f < out.n_faces(); ++f)
+        if (!out_selected[f]) kept.insert({out.corners.begin() + offsets[f], out.corners.begin() + offsets[f + 1]});
+      EXPECT_EQ(kept.size(), 5u);
+      for (std::size_t f = 4; f < 9; ++f) {
+        bool found = false;
+        for (const auto& corners : kept) {
+          std::vector<std::uint32_t> want(soup.corners.begin() + 3 * f, soup.corners.begin() + 3 * f + 3);
+          for (int turn = 0; turn < 3 && !found; ++turn) {
+            std::vector<Point> a, b;
+            for (std::uint32_t c : corners) a.push_back(out.positions[c]);
+            for (std::uint32_t c : want) b.push_back(soup.positions[c]);
+            found = a == b;
+            std::rotate(want.begin(), want.begin() + 1, want.end());
+          }
+        }
+        EXPECT_TRUE(found) << "input face " << f;
+      }
+    }
+}
+
+// A real scan with holes and split non-manifold edges, half selected.
+TEST(SubdivideSelection, MessyScanHalfSelected) {
+  Mesh scan = load("dragon_res3.ply");
+  if (scan.is_empty()) GTEST_SKIP() << "dragon_res3.ply not found";
+  select_left_half(scan);
+  for (auto s : kAllSchemes) {
+    Mesh mesh = scan;
+    const SubdivideOptions o = selection_only(s, 2);
+    subdivide(mesh, o);
+    expect_selection_contract(scan, mesh, o);
+    EXPECT_LE(mesh.n_faces(), subdivided_face_count(scan, o));
+    EXPECT_EQ(extract(mesh).n_faces(), mesh.n_faces());
+  }
+}
+
+TEST(SubdivideSelection, SameResultAtEveryThreadCount) {
+  Mesh bunny = load("bunny.off");
+  if (bunny.is_empty()) GTEST_SKIP() << "bunny.off not found";
+  select_left_half(bunny);
+  for (auto s : kAllSchemes) {
+    Mesh reference;
+    for (unsigned threads : {1u, 3u}) {
+      hedge::testing::set_parallel_grain(64);
+      Mesh mesh = bunny;
+      SubdivideOptions o = selection_only(s, 2);
+      o.threads = threads;
+      subdivide(mesh, o);
+      hedge::testing::set_parallel_grain(0);
+      if (threads == 1) {
+        reference = mesh;
+        continue;
+      }
+      SCOPED_TRACE(subdivision_scheme_name(s));
+      expect_same_mesh(mesh, reference);
+    }
+  }
+}
+
+TEST(SubdivideSelection, CatalogueParameter) {
+  const Operation& op = find_operation("subdivide");
+  const ParamSpec* p = op.find_param("selection_only");
+  ASSERT_NE(p, nullptr);
+  EXPECT_EQ(p->default_value, Value(false));
 }
 
 }  // namespace

@@ -27,6 +27,9 @@ struct SubdivideOptions {
   //! Degrees, 0 to 180: an interior edge whose two faces' normals differ by more is a crease
   //! (kept sharp, see subdivide()). 180: none.
   double crease_angle = 180;
+  //! Refine only the selected faces (the "selected" face channel, selection.h); the others come
+  //! back as they were, and so does the border between the two (see subdivide()).
+  bool selection_only = false;
 };
 
 struct SubdivideReport {
@@ -37,8 +40,10 @@ struct SubdivideReport {
 };
 
 //! Face count after `options.iterations` steps of `options.scheme`, without refining.
-//! Precondition for loop and sqrt3: a triangle mesh. (sqrt3 with a crease angle measures the
-//! creases, which its trisecting steps cut in three.)
+//! Precondition for loop and sqrt3: a triangle mesh (with selection_only: triangles where
+//! selected). (sqrt3 with a crease angle measures the creases, which its trisecting steps cut
+//! in three.) With selection_only an upper bound: the unselected faces plus the selected ones
+//! counted as if every edge of theirs were split (the closures below make fewer).
 std::size_t subdivided_face_count(const Mesh& mesh, const SubdivideOptions& options);
 
 //! Refines the mesh `options.iterations` times.
@@ -77,11 +82,43 @@ std::size_t subdivided_face_count(const Mesh& mesh, const SubdivideOptions& opti
 //! are refreshed: vertex and face normals recomputed from the refined shape, corner normals
 //! (blended per face, so hard edges stay hard) scaled back to unit length.
 //!
+//! selection_only: only the selected faces are refined; every other face comes back with the
+//! same corners at bit-identical positions, so the border between selected and unselected
+//! faces stays where it is, closed (selection.h). An edge with an unselected face on either
+//! side (on any copy of it, for edges build() split) is a border edge: it is never split,
+//! flipped or cut. A vertex with an unselected face around it (or a copy of a split vertex)
+//! keeps its position and attributes; the other vertices, edge points and face points take
+//! the scheme's usual stencils (which may read border vertices). Selected faces that have
+//! border edges are closed without T-junctions:
+//! - loop, and midpoint on triangles: a triangle with 3 split edges gives 4 as usual; with 2,
+//!   the corner triangle between the two edge points, and the quad left over cut along its
+//!   shorter diagonal (measured with the edge points at the midpoints; on a tie, the one from
+//!   the unsplit edge's second corner in the face's order), so 3; with 1, the edge point
+//!   joined to the opposite corner, so 2; with none it stays as it is.
+//! - catmull_clark, and midpoint on polygons: a face point joins every edge point of the face;
+//!   each piece runs from one edge point along the rim (corners, unsplit edges included) to the
+//!   next and back through the face point, so a piece with an unsplit edge has more than 4
+//!   corners. With a single split edge, the face point joins that edge point and the
+//!   ((n + 1) / 2, rounded down)-th corner after it along the face (a triangle's opposite
+//!   corner, a quad's second): two pieces.
+//!   A face with no split edge (all its corners are on the border) stays as it is.
+//! - sqrt3: every selected triangle is split 1 -> 3 at its centroid; an old edge is flipped
+//!   only between two selected faces; the even steps cut the boundary edges of selected faces
+//!   and creases between selected faces, never a border edge. So along the border the
+//!   triangles keep the old edge, as along a boundary on odd steps, on every step.
+//! Children of a selected face stay selected, so later iterations refine the same region.
+//! The pieces along the border keep its whole edges while the selection around them shrinks,
+//! so over several iterations they grow long and thin: the price of a border that stays.
+//! loop and sqrt3 need only the selected faces to be triangles. Nothing selected: the mesh is
+//! returned unchanged.
+//!
 //! Numbering (on a mesh without deleted elements): old vertices keep their indices; loop,
 //! catmull_clark and midpoint put the point of edge e at vertex V + e and face points after
-//! those, in face order; sqrt3 puts the point of face f at V + f.
+//! those, in face order; sqrt3 puts the point of face f at V + f. With selection_only, the
+//! points that are not made (unsplit edges, unselected faces) leave no gap: the others follow
+//! in the same order.
 //!
-//! Throws Error, leaving the mesh untouched, for polygons under loop/sqrt3, results above
+//! Throws Error, leaving the mesh untouched, for (selected) polygons under loop/sqrt3, results above
 //! options.max_faces, crease_angle outside 0 to 180; Cancelled
 //! through progress likewise.
 SubdivideReport subdivide(Mesh& mesh, const SubdivideOptions& options, Progress& progress = Progress::none());

@@ -20,13 +20,16 @@
 #include "hedge/normals.h"
 #include "hedge/provenance.h"
 #include "hedge/topology.h"
+#include "selection.h"
 #include "subdivide_refine.h"
 
 namespace hedge {
 namespace {
 
 using subdivision::detect_creases;
+using subdivision::drop_unlinked;
 using subdivision::face_size;
+using subdivision::Region;
 using subdivision::split_creases;
 using subdivision::split_step;
 using subdivision::sqrt3_step;
@@ -88,14 +91,20 @@ void weld_split_edge_points(const Mesh& before, Mesh& after) {
 
 //! Faces by kind, in one pass: what the refusals and the size forecast need.
 struct FaceCensus {
-  std::size_t faces = 0, triangles = 0, corners = 0;
+  std::size_t faces = 0, triangles = 0, corners = 0;  //!< of the faces refined
+  std::size_t kept = 0;                               //!< with selection_only: faces left as they are
   //! What a trisecting sqrt3 step cuts (count_sqrt3_cuts): boundary edges but seams, creases.
   std::size_t boundary_edges = 0, crease_edges = 0;
 };
 
-FaceCensus face_census(const Mesh& mesh) {
+//! `selected`: per face, empty for all (selection_only off).
+FaceCensus face_census(const Mesh& mesh, const std::vector<std::uint8_t>& selected = {}) {
   FaceCensus c;
   for (Face f : mesh.faces()) {
+    if (!selected.empty() && !selected[f.idx()]) {
+      ++c.kept;
+      continue;
+    }
     const Index n = face_size(mesh, f);
     ++c.faces;
     c.triangles += n == 3;
@@ -105,14 +114,20 @@ FaceCensus face_census(const Mesh& mesh) {
 }
 
 //! Fills in what sqrt3 cuts on its even steps (sqrt3_step): boundary edges other than the seams
-//! of split non-manifold edges, and the `crease_edges` creases. Others need no such count.
-void count_sqrt3_cuts(const Mesh& mesh, const SubdivideOptions& options, std::size_t crease_edges, FaceCensus& c) {
+//! of split non-manifold edges, and the creases (`crease`, per edge, empty for none); with
+//! selection_only (`region` not all()) only those it opens. Others need no such count.
+void count_sqrt3_cuts(const Mesh& mesh, const SubdivideOptions& options, const std::vector<bool>& crease,
+                      const Region& region, FaceCensus& c) {
   if (options.scheme != SubdivisionScheme::sqrt3 || options.iterations < 2) return;
-  c.crease_edges = crease_edges;
-  for (Edge e : mesh.edges()) c.boundary_edges += mesh.is_boundary(e) ? 1 : 0;
-  if (c.boundary_edges == 0) return;
-  const std::vector<bool> seam = split_seam_edges(mesh);
-  c.boundary_edges -= std::size_t(std::count(seam.begin(), seam.end(), true));
+  std::vector<bool> seam;
+  bool seams_found = false;
+  for (Edge e : mesh.edges()) {
+    if (!region.opens(e)) continue;
+    c.crease_edges += !crease.empty() && crease[e.idx()];
+    if (!mesh.is_boundary(e)) continue;
+    if (!seams_found) seam = split_seam_edges(mesh), seams_found = true;
+    c.boundary_edges += seam.empty() || !seam[e.idx()];
+  }
 }
 
 //! Corner normals were blended inside each face (hard edges stay hard): back to unit length.
@@ -127,7 +142,9 @@ void normalize_corner_normals(Mesh& mesh) {
   }
 }
 
-std::size_t forecast_faces(const FaceCensus& c, const SubdivideOptions& options) {
+//! Faces that the refined faces of the census become (with selection_only an upper bound: as
+//! if every edge of theirs were split; a closure makes fewer).
+std::size_t forecast_refined(const FaceCensus& c, const SubdivideOptions& options) {
   if (options.iterations <= 0 || c.faces == 0) return c.faces;
   // Doubles, so that absurd requests compare as huge instead of wrapping around.
   double first = 0;
@@ -162,6 +179,10 @@ std::size_t forecast_faces(const FaceCensus& c, const SubdivideOptions& options)
   const double factor = options.scheme == SubdivisionScheme::sqrt3 ? 3.0 : 4.0;
   const double total = first * std::pow(factor, options.iterations - 1);
   return total >= 1e18 ? std::size_t(1e18) : std::size_t(total);
+}
+
+std::size_t forecast_faces(const FaceCensus& c, const SubdivideOptions& options) {
+  return std::min(forecast_refined(c, options), std::size_t(1e18) - c.kept) + c.kept;
 }
 
 //! Refuses, before starting, subdivisions whose vertices, half-edges or faces would not fit
@@ -239,13 +260,14 @@ const char* subdivision_scheme_name(SubdivisionScheme scheme) {
 }
 
 std::size_t subdivided_face_count(const Mesh& mesh, const SubdivideOptions& options) {
-  FaceCensus census = face_census(mesh);
-  std::size_t crease_edges = 0;
-  if (options.scheme == SubdivisionScheme::sqrt3 && options.crease_angle < 180) {
-    const std::vector<bool> crease = detect_creases(mesh, options.crease_angle);
-    crease_edges = std::size_t(std::count(crease.begin(), crease.end(), true));
+  FaceCensus census =
+      face_census(mesh, options.selection_only ? detail::selected_faces(mesh) : std::vector<std::uint8_t>());
+  if (options.scheme == SubdivisionScheme::sqrt3 && options.iterations >= 2) {
+    std::vector<bool> crease;
+    if (options.crease_angle < 180) crease = detect_creases(mesh, options.crease_angle);
+    count_sqrt3_cuts(mesh, options, crease, options.selection_only ? subdivision::selected_region(mesh) : Region(),
+                     census);
   }
-  count_sqrt3_cuts(mesh, options, crease_edges, census);
   return forecast_faces(census, options);
 }
 
@@ -255,12 +277,23 @@ SubdivideReport subdivide(Mesh& mesh, const SubdivideOptions& options, Progress&
   if (!(options.crease_angle >= 0 && options.crease_angle <= 180))
     throw Error("subdivide: crease_angle must be from 0 to 180 degrees");
   const bool triangles_only = options.scheme == SubdivisionScheme::loop || options.scheme == SubdivisionScheme::sqrt3;
-  const FaceCensus faces = face_census(mesh);
+  // With selection_only, what is refined: the selected faces (only they must be triangles).
+  const FaceCensus faces =
+      face_census(mesh, options.selection_only ? detail::selected_faces(mesh) : std::vector<std::uint8_t>());
   const std::size_t faces_before = mesh.n_faces();
+  if (options.selection_only && faces.faces == 0) {
+    // Nothing selected: nothing changes (the binding says so); no step was made.
+    SubdivideReport report;
+    report.faces_before = report.faces = faces_before;
+    report.vertices = mesh.n_vertices();
+    report.edges = mesh.n_edges();
+    return report;
+  }
   if (triangles_only) {
     if (std::size_t polygons = faces.faces - faces.triangles)
       throw Error(std::string("subdivide: the ") + name + " scheme works on triangle meshes, and " +
-                  std::to_string(polygons) + (polygons == 1 ? " face has" : " faces have") +
+                  std::to_string(polygons) + (options.selection_only ? " selected" : "") +
+                  (polygons == 1 ? " face has" : " faces have") +
                   " more than 3 corners; triangulate first, or use catmull_clark or midpoint");
   }
 
@@ -282,9 +315,16 @@ SubdivideReport subdivide(Mesh& mesh, const SubdivideOptions& options, Progress&
     crease_edges = std::size_t(std::count(crease.begin(), crease.end(), true));
     if (crease_edges == 0) crease.clear();
   }
-  FaceCensus census = faces;
-  count_sqrt3_cuts(*current, options, crease_edges, census);
-  check_index_limits(*current, census, options, name);
+  // A step allocates for every edge and face (drop_unlinked() then removes what a selection
+  // left unused), so the index limits count the whole mesh; the forecast what is refined.
+  FaceCensus whole = options.selection_only ? face_census(*current) : faces;
+  count_sqrt3_cuts(*current, options, crease, Region(), whole);
+  check_index_limits(*current, whole, options, name);
+  FaceCensus census = whole;
+  if (options.selection_only) {
+    census = faces;
+    count_sqrt3_cuts(*current, options, crease, subdivision::selected_region(*current), census);
+  }
   const std::size_t predicted = forecast_faces(census, options);
   if (predicted > options.max_faces)
     throw Error("subdivide: " + std::to_string(options.iterations) + " iterations of " + name + " would make " +
@@ -294,14 +334,17 @@ SubdivideReport subdivide(Mesh& mesh, const SubdivideOptions& options, Progress&
   for (int it = 0; it < options.iterations; ++it) {
     const double from = double(it) / options.iterations, to = double(it + 1) / options.iterations;
     progress.update(from, "subdividing: step " + std::to_string(it + 1) + " of " + std::to_string(options.iterations));
+    // The selection is read anew on each step: the children of a selected face are selected.
+    const Region region = options.selection_only ? subdivision::selected_region(*current) : Region();
     Mesh next;
     if (options.scheme == SubdivisionScheme::sqrt3) {
-      next = sqrt3_step(*current, it % 2 == 1, crease, options.threads, progress, from, to);
+      next = sqrt3_step(*current, it % 2 == 1, crease, region, options.threads, progress, from, to);
     } else {
-      next = split_step(*current, options.scheme, crease, options.threads, progress, from, to);
+      next = split_step(*current, options.scheme, crease, region, options.threads, progress, from, to);
       weld_split_edge_points(*current, next);
       if (!crease.empty()) crease = split_creases(crease, next.edges_size());
     }
+    if (!region.all()) drop_unlinked(next, Index(current->vertices_size()), crease);
     result = std::move(next);
     current = &result;
   }
@@ -351,6 +394,10 @@ Operation subdivide_operation() {
       .option(&O::crease_angle, "crease_angle", "Crease angle", between(0, 180),
               "degrees: edges where the two faces' normals differ by more than this stay sharp (creases "
               "and corners, e.g. a cube's edges at 60); 180 smooths everything")
+      .selection(&O::selection_only,
+                 "Only the selected faces are refined; the faces outside the selection stay as they are, and so does "
+                 "the border between the two: its edges are not split and its vertices do not move, and the selected "
+                 "faces along it are closed without cracks.")
       .result(
           "scheme",
           [](const O& o, const R&) -> std::optional<Value> { return std::string(subdivision_scheme_name(o.scheme)); })

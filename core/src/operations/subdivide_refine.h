@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <initializer_list>
 #include <numbers>
 #include <span>
@@ -184,10 +185,12 @@ void refine_vertices(const Mesh& m, Mesh& out, const VertexRule& rule, unsigned 
       for (std::size_t v = lo; v < hi; ++v) {
         s.clear();
         even(Vertex(Index(v)), s);
-        if (positions) p[v] = position(s);
+        // A vertex that stays is copied, bit for bit (a blend would turn -0 into +0).
+        const bool stays = s.size() == 1 && s.index(0) == v && s.weight(0) == 1.0f;
+        if (positions) p[v] = stays ? old_p[v] : position(s);
         if (properties)
           for (const Target& x : all) {
-            if (x.internal)
+            if (x.internal || stays)
               x.array->copy_element(v, V + N + v);
             else
               blend(x, V + N + v, s.index(), s.weight());
@@ -255,19 +258,49 @@ struct StepOutput {
 };
 
 //! Makes `loop` (half-edges in order) the loop of face t: each one's next and face.
-inline void link_loop(Mesh& out, Face t, std::initializer_list<Halfedge> loop) {
-  const Halfedge* h = loop.begin();
+inline void link_loop(Mesh& out, Face t, std::span<const Halfedge> loop) {
+  const Halfedge* h = loop.data();
   const std::size_t n = loop.size();
   for (std::size_t i = 0; i < n; ++i) {
     out.set_next(h[i], h[i + 1 == n ? 0 : i + 1]);
     out.set_face(h[i], t);
   }
 }
+inline void link_loop(Mesh& out, Face t, std::initializer_list<Halfedge> loop) {
+  link_loop(out, t, std::span<const Halfedge>(loop.begin(), loop.size()));
+}
 
 //! Edge or face properties of a step: each new element copies its parent's (`map`), slot
 //! `default_slot` the defaults; `size` new elements when there are no properties.
 void copy_parents(PropertyContainer from, PropertyContainer& to, std::size_t default_slot,
                   const std::vector<Index>& map, std::size_t size);
+
+// ---- selection_only ---------------------------------------------------------------------------
+
+//! What one step may change with selection_only (subdivide.h, selection.h). Empty: everything
+//! (a run without selection_only), and every test below is true.
+struct Region {
+  std::vector<std::uint8_t> face;    //!< per face: selected, so refined
+  std::vector<std::uint8_t> vertex;  //!< per vertex: every face around it selected, so it may move
+  //! Per edge: no unselected face on either side, nor on a copy that extract() welds with it,
+  //! so it may be split, flipped or cut. The others are the border and what lies outside it.
+  std::vector<std::uint8_t> edge;
+
+  bool all() const { return face.empty(); }
+  bool refines(Face f) const { return face.empty() || face[f.idx()]; }
+  bool moves(Vertex v) const { return vertex.empty() || vertex[v.idx()]; }
+  bool opens(Edge e) const { return edge.empty() || edge[e.idx()]; }
+};
+
+//! The region of m's "selected" faces (all flags zero when it has none).
+Region selected_region(const Mesh& m);
+
+//! A step with a Region leaves the elements it did not make (the points of unsplit edges, the
+//! second halves of unsplit edges, the pieces of unselected faces) with invalid connectivity:
+//! removes them, keeping the others in order. Added vertices (index `old_vertices` and up)
+//! without a half-edge, edges whose side 0 has no vertex and faces without a half-edge go;
+//! `crease` (per edge, empty for none) follows the edges.
+void drop_unlinked(Mesh& m, Index old_vertices, std::vector<bool>& crease);
 
 // ---- creases ----------------------------------------------------------------------------------
 
@@ -299,14 +332,16 @@ std::vector<bool> split_creases(const std::vector<bool>& crease, std::size_t edg
 
 //! Loop, Catmull–Clark and midpoint (subdivide_split.cpp): every edge split at an edge point,
 //! every face split 1 -> 4 or into quads. `crease`: per edge of m, empty for none (then the
-//! rules are exactly the crease-free ones).
-Mesh split_step(const Mesh& m, SubdivisionScheme scheme, const std::vector<bool>& crease, unsigned threads,
-                Progress& progress, double from, double to);
+//! rules are exactly the crease-free ones). `region` not all(): only its edges are split and
+//! its faces refined (closed as subdivide.h says); the result then needs drop_unlinked().
+Mesh split_step(const Mesh& m, SubdivisionScheme scheme, const std::vector<bool>& crease, const Region& region,
+                unsigned threads, Progress& progress, double from, double to);
 
 //! √3 (subdivide_sqrt3.cpp): a vertex per face, then every interior old edge flipped; every
 //! second step (`trisect`) cuts boundary edges and creases in three. `crease`: per edge of m,
-//! empty for none; on return per edge of the result.
-Mesh sqrt3_step(const Mesh& m, bool trisect, std::vector<bool>& crease, unsigned threads, Progress& progress,
-                double from, double to);
+//! empty for none; on return per edge of the result. `region` not all(): only its faces are
+//! split and its edges flipped or cut; the result then needs drop_unlinked().
+Mesh sqrt3_step(const Mesh& m, bool trisect, std::vector<bool>& crease, const Region& region, unsigned threads,
+                Progress& progress, double from, double to);
 
 }  // namespace hedge::subdivision

@@ -25,8 +25,13 @@ namespace hedge::subdivision {
 // E + 3F + 4B + 6c + {0: Q1-Q2, 1: Q2-B} and, for its side s, + 2 + 2s (the spoke from the Q
 // nearer that side's origin to its face point) and + 3 + 2s (from the other Q), and faces
 // 3F + 2B + 4c + 2s + {0, 1}. On return `crease` is per edge of the result.
-Mesh sqrt3_step(const Mesh& m, bool trisect, std::vector<bool>& crease, unsigned threads, Progress& progress,
-                double from, double to) {
+//
+// With selection_only (`region`), an edge that the region does not open is held like a
+// boundary seen from both sides, never flipped and never cut, and a face outside it keeps its
+// half-edges as face 3f; its point V + f, spokes and faces 3f + 1, 3f + 2 stay unlinked
+// (drop_unlinked()). Only the boundary edges and creases the region opens are cut.
+Mesh sqrt3_step(const Mesh& m, bool trisect, std::vector<bool>& crease, const Region& region, unsigned threads,
+                Progress& progress, double from, double to) {
   const Index V = Index(m.vertices_size()), E = Index(m.edges_size()), F = Index(m.faces_size());
   const Index H = 2 * E;
   const bool creases = !crease.empty();
@@ -41,14 +46,14 @@ Mesh sqrt3_step(const Mesh& m, bool trisect, std::vector<bool>& crease, unsigned
     boundary_number.assign(E, kInvalidIndex);
     for (Index e = 0; e < E; ++e)
       for (unsigned side = 0; side < 2; ++side)
-        if (m.is_boundary(Mesh::halfedge(Edge(e), side)) && (seam.empty() || !seam[e])) {
+        if (m.is_boundary(Mesh::halfedge(Edge(e), side)) && (seam.empty() || !seam[e]) && region.opens(Edge(e))) {
           boundary_number[e] = Index(boundary_inner.size());
           boundary_inner.push_back(Mesh::halfedge(Edge(e), 1 - side));
         }
     if (creases) {
       crease_number.assign(E, kInvalidIndex);
       for (Index e = 0; e < E; ++e)
-        if (crease[e]) {
+        if (crease[e] && region.opens(Edge(e))) {
           crease_number[e] = Index(cut_creases.size());
           cut_creases.push_back(Edge(e));
         }
@@ -69,6 +74,7 @@ Mesh sqrt3_step(const Mesh& m, bool trisect, std::vector<bool>& crease, unsigned
     return Halfedge(2 * (crease_edge0 + 6 * c + which) + side);
   };
   auto is_crease = [&](Edge e) { return creases && crease[e.idx()]; };
+  auto is_cut_crease = [&](Edge e) { return trisect && creases && crease_number[e.idx()] != kInvalidIndex; };
   // An interior edge that extract()'s weld makes one with another (a split non-manifold
   // edge) is not flipped either, nor cut: flipping one copy would leave the others' faces
   // on an edge that no longer exists, and its ends with fans that no longer meet.
@@ -151,6 +157,19 @@ Mesh sqrt3_step(const Mesh& m, bool trisect, std::vector<bool>& crease, unsigned
 
   parallel_for(F, threads, [&](std::size_t lo, std::size_t hi) {
     for (Index f = Index(lo); f < hi; ++f) {
+      if (!region.refines(Face(f))) {
+        // Outside the selection: the same loop, as face 3f.
+        const Face t(3 * f);
+        for (Halfedge h : m.halfedges(Face(f))) {
+          out.set_vertex(h, m.to_vertex(h));
+          out.set_next(h, m.next(h));
+          out.set_face(h, t);
+          if (corner_props) hmap[h.idx()] = h.idx();
+        }
+        out.set_halfedge(t, m.halfedge(Face(f)));
+        if (face_props) fmap[t.idx()] = f;
+        continue;
+      }
       const Vertex pf(V + f);
       Halfedge h = m.halfedge(Face(f));
       for (Index i = 0; i < 3; ++i, h = m.next(h)) {
@@ -160,7 +179,7 @@ Mesh sqrt3_step(const Mesh& m, bool trisect, std::vector<bool>& crease, unsigned
         const Halfedge g = Mesh::opposite(h);
         const Edge e = Mesh::edge(h);
         const Halfedge a = spoke(f, i, 1);
-        const bool boundary = m.is_boundary(g), sharp = boundary || is_crease(e) || is_welded(e);
+        const bool boundary = m.is_boundary(g), sharp = boundary || is_crease(e) || is_welded(e) || !region.opens(e);
         if (boundary && is_cut(g)) {
           const Index k = boundary_number[e.idx()];
           const Vertex q1(V + F + 2 * k), q2(V + F + 2 * k + 1);
@@ -180,7 +199,7 @@ Mesh sqrt3_step(const Mesh& m, bool trisect, std::vector<bool>& crease, unsigned
           if (edge_props) emap[Mesh::edge(s1).idx()] = emap[Mesh::edge(s2).idx()] = e.idx();
           continue;
         }
-        if (trisect && is_crease(e)) {
+        if (is_cut_crease(e)) {
           // A crease: its side 0 runs A -> Q1 -> Q2 -> B, side 1 B -> Q2 -> Q1 -> A.
           const Index c = crease_number[e.idx()];
           const unsigned side = h == Mesh::halfedge(e, 0) ? 0 : 1;
@@ -245,11 +264,14 @@ Mesh sqrt3_step(const Mesh& m, bool trisect, std::vector<bool>& crease, unsigned
     }
   });
   // Old vertices: boundary ones keep their boundary half-edge; interior ones leave along a
-  // spoke, since their old edges were flipped away.
+  // spoke, since their old edges were flipped away (or along their old half-edge when its
+  // face is outside the selection, where nothing changed).
   for (Index v = 0; v < V; ++v) {
     const Halfedge h = m.halfedge(Vertex(v));
     if (!h.is_valid() || m.is_boundary(h)) {
       out.set_halfedge(Vertex(v), h.is_valid() ? boundary_out(h) : h);
+    } else if (!region.refines(m.face(h))) {
+      out.set_halfedge(Vertex(v), h);
     } else {
       const Halfedge in = m.prev(h);  // points to v inside face(h)
       out.set_halfedge(Vertex(v), spoke(m.face(h).idx(), corner[in.idx()], 1));
@@ -291,11 +313,15 @@ Mesh sqrt3_step(const Mesh& m, bool trisect, std::vector<bool>& crease, unsigned
     s.add(far.idx(), 10.0f / 27);
   };
   auto even = [&](Vertex v, Stencil& s) {
+    if (!region.moves(v)) {
+      s.add(v.idx(), 1.0f);  // on the border of the selection or outside it: stays
+      return;
+    }
     if (creases && m.halfedge(v).is_valid()) {
       // As for Loop: a corner (three or more sharp edges) stays, a vertex on two follows the
       // curve rule along them (here the boundary's), a dart (one) the smooth rule.
       const SharpEdges sharp = sharp_edges(m, crease, v);
-      auto cut = [&](Halfedge h) { return is_cut(h) || (trisect && is_crease(Mesh::edge(h))); };
+      auto cut = [&](Halfedge h) { return is_cut(h) || is_cut_crease(Mesh::edge(h)); };
       if (sharp.count >= 3 || (sharp.count == 2 && (!cut(sharp.out[0]) || !cut(sharp.out[1])))) {
         s.add(v.idx(), 1.0f);
         return;
