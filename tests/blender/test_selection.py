@@ -1,6 +1,6 @@
 # selection_only in Blender: the operators in Edit Mode follow its selection, hedge.run() the
 # mesh's stored one. Faces outside the selection come back as they were (decimate, remesh,
-# triangulate, make_delaunay); smoothing moves only the selected vertices; nothing selected changes nothing.
+# subdivide, triangulate, make_delaunay); smoothing moves only the selected vertices; nothing selected changes nothing.
 import os
 import sys
 
@@ -90,6 +90,12 @@ class SelectionTest(unittest.TestCase):
 
     def test_make_delaunay_in_edit_mode(self):
         self.check_outside_kept("make_delaunay")
+
+    def test_subdivide_in_edit_mode(self):
+        # Loop refines the selected triangles; those along the border close up without splitting it.
+        outside, inside = self.check_outside_kept("subdivide")
+        self.assertGreater(len(faces_where(self.obj.data, True)), 3 * len(inside))
+        self.assertFalse(problems(self.obj.data))
 
     def test_remesh_in_edit_mode(self):
         self.check_outside_kept("remesh", iterations=3)

@@ -313,7 +313,7 @@ std::vector<std::vector<float>> faces_selected(const CMeshO& m, bool want) {
 
 // MeshLab's face selection drives selection_only: faces outside it come back as they were.
 TEST_F(PluginTest, SelectionOnlyKeepsTheFacesOutsideTheSelection) {
-  for (const char* op_id : {"decimate", "remesh", "smooth", "make_delaunay"}) {
+  for (const char* op_id : {"decimate", "remesh", "smooth", "make_delaunay", "subdivide"}) {
     SCOPED_TRACE(op_id);
     Document doc(mesh_path("bunny.off"));
     CMeshO& m = doc.model->cm;
