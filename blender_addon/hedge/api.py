@@ -38,6 +38,7 @@ class Target:
         self.obj = obj
         self.edit = obj.mode == 'EDIT'
         self.scratch = None
+        self.read_from = None  # the mesh read: the object's, or the edit mesh's scratch copy
         self.data = None
         self.result = None
         self.report = None
@@ -60,11 +61,17 @@ class Target:
                 self.scratch = bpy.data.meshes.new("hedge scratch")
                 bmesh.from_edit_mesh(me).to_mesh(self.scratch)
             me = self.scratch
-        self.data = exchange.read_mesh(me)
+        self.read_from = me
+        self.data = exchange.read_mesh(me, edges=False)
         exchange.read_vertex_groups(self.obj, self.obj.data, self.data)
         if carry_keys:
             exchange.read_shape_keys(me, self.data)
         return self.data.soup
+
+    def read_rest(self):
+        """What only writing the result back needs (read while the operation runs)."""
+        if self.data is not None and not self.data.edges_read:
+            exchange.read_edges(self.read_from, self.data)
 
     def check_writable(self, op):
         """Refuses, before anything is written, what the exchange cannot keep consistent."""
@@ -78,6 +85,7 @@ class Target:
 
     def write(self):
         if self.result is not None:
+            self.read_rest()
             if self.edit:
                 # A stand-in object lets the vertex groups be rebuilt on the scratch mesh, in
                 # the object's order, before the edit mesh loads it (a copy of the object's
@@ -132,6 +140,8 @@ def targets(context):
     return out
 
 
+# How often a synchronous run reports progress.
+PROGRESS_SECONDS = 0.1
 # How many of an operation's results (catalogue order) the one-line summary shows.
 SUMMARY_RESULTS = 4
 
@@ -173,6 +183,10 @@ class Batch:
                 params[p["id"]] = exchange.vertex_attribute_channel(t.data, params[p["id"]])
         return soup, params
 
+    def read_rest(self):
+        """The write-back data of the mesh read_next() read, while its operation runs."""
+        self.targets[self.index].read_rest()
+
     def record(self, result, report):
         """Keeps the next mesh's result (from native.run or a Job)."""
         t = self.targets[self.index]
@@ -196,18 +210,19 @@ class Batch:
 
 def run_targets(op_id, target_list, params, progress=None):
     """Runs one operation on several targets, synchronously; writes nothing unless every one
-    succeeded."""
+    succeeded. `progress(fraction, stage)` is called every PROGRESS_SECONDS; False cancels."""
     batch = Batch(op_id, target_list, params)
     native_module = require_native()
     n = len(target_list)
     try:
         while not batch.finished():
-            step = None
-            if progress is not None:
-                def step(fraction, stage, i=batch.index):
-                    return progress((i + fraction) / n, stage)
-            soup, params = batch.read_next()
-            batch.record(*native_module.run(op_id, soup, params, step))
+            job = native_module.Job(op_id, *batch.read_next())
+            batch.read_rest()  # on this thread, while the job runs on its own
+            while not job.wait(PROGRESS_SECONDS):
+                fraction, stage = job.progress()
+                if progress is not None and not progress((batch.index + fraction) / n, stage):
+                    job.cancel()  # result() then raises Cancelled
+            batch.record(*job.result())
         return batch.commit()
     except BaseException:
         batch.release()

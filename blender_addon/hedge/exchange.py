@@ -163,14 +163,16 @@ class MeshData:
         self.edges = None         # (n, 2) int32 vertex pairs
         self.edge_data = {}       # name -> array per edge (flags, crease, bevel weight)
         self.edge_attributes = [] # (name, data_type) generic edge attributes, values in edge_data
+        self.edges_read = False   # read_edges() done
         self.not_carried = []     # what could not cross, for the report
         self.vertex_groups = []   # names, in order, when read (read_vertex_groups)
         self.active_group = -1
         self.shape_keys = []      # key block names in order, the reference key first (read_shape_keys)
 
 
-def read_mesh(me):
-    """Reads a bpy.types.Mesh (object mode data) into a MeshData."""
+def read_mesh(me, edges=True):
+    """Reads a bpy.types.Mesh (object mode data) into a MeshData; its edges' data too unless
+    `edges` is False (read_edges() then reads them before writing back)."""
     d = MeshData()
     nv, nl, nf, ne = len(me.vertices), len(me.loops), len(me.polygons), len(me.edges)
     positions = _get(me.vertices, "co", nv, np.float32, 3)
@@ -260,6 +262,19 @@ def read_mesh(me):
         channels.append(("bevel_weight", "vertex", _get(me.vertices, "bevel_weight", nv, np.float32)))
     channels.append(("blender:vertex", "vertex", np.arange(nv, dtype=np.int32)))
 
+    if me.has_custom_normals:
+        d.not_carried.append("custom split normals")
+    d.soup = {"positions": positions, "face_sizes": loop_total, "corners": corners, "channels": channels}
+    if edges:
+        read_edges(me, d)
+    return d
+
+
+def read_edges(me, d):
+    """Adds to `d` what only the write-back needs, which may be read while the operation runs:
+    the edges' flags and layers, keyed by their vertex pairs."""
+    ne = len(me.edges)
+    builtin = builtin_attributes()
     for prop, attribute in EDGE_FLAGS:
         if prop not in _EDGE_PROPERTIES or attribute in me.attributes:
             continue
@@ -277,10 +292,7 @@ def read_mesh(me):
         d.edges = _builtin(me, ".edge_verts", ne, np.int32, 0, 2)
     else:
         d.edges = _get(me.edges, "vertices", ne, np.int32, 2)
-    if me.has_custom_normals:
-        d.not_carried.append("custom split normals")
-    d.soup = {"positions": positions, "face_sizes": loop_total, "corners": corners, "channels": channels}
-    return d
+    d.edges_read = True
 
 
 def _socket(sockets, name, kind):

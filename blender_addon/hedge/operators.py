@@ -142,6 +142,7 @@ class HedgeOperator:
     def _next(self):
         if not self._batch.finished():
             self._job = require_native().Job(self.operation["id"], *self._batch.read_next())
+            self._batch.read_rest()
 
     def _release(self):
         self._batch.release()

@@ -9,6 +9,7 @@
 #include <cstring>
 #include <exception>
 #include <memory>
+#include <condition_variable>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -282,7 +283,11 @@ class Job {
       } catch (...) {
         error_ = std::current_exception();
       }
-      done_.store(true);
+      {
+        std::lock_guard lock(mutex_);
+        done_.store(true);
+      }
+      finished_.notify_all();
     });
   }
   ~Job() {
@@ -293,6 +298,14 @@ class Job {
     }
   }
   bool done() const { return done_.load(); }
+  // Until done or `seconds` have passed, without the GIL: the caller's thread meanwhile reads
+  // what the operation does not need, and wakes as soon as it is done.
+  bool wait(double seconds) {
+    py::gil_scoped_release nogil;
+    std::unique_lock lock(mutex_);
+    finished_.wait_for(lock, std::chrono::duration<double>(seconds), [this] { return done_.load(); });
+    return done_.load();
+  }
   void cancel() { cancel_.store(true); }
   py::tuple progress() {
     std::lock_guard lock(mutex_);
@@ -315,6 +328,7 @@ class Job {
   std::thread thread_;
   std::atomic<bool> done_{false}, cancel_{false};
   std::mutex mutex_;
+  std::condition_variable finished_;
   double fraction_ = 0;
   std::string stage_;
   std::optional<RunResult> result_;
@@ -397,6 +411,7 @@ PYBIND11_MODULE(_native, m) {
       .def(py::init<const std::string&, const py::dict&, const py::dict&>(), py::arg("operation"), py::arg("mesh"),
            py::arg("params") = py::dict())
       .def("done", &Job::done)
+      .def("wait", &Job::wait, py::arg("seconds"))
       .def("cancel", &Job::cancel)
       .def("progress", &Job::progress)
       .def("result", &Job::result);
