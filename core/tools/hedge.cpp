@@ -257,8 +257,11 @@ int distance_command(const std::vector<std::string>& args) {
 }
 
 void print_param(const ParamSpec& p) {
-  std::printf("    %-24s %-5s default %-8s %s\n", flag_of(p.id).c_str(), param_type_name(p.type),
-              p.default_text().c_str(), p.range_text().c_str());
+  // A vertex attribute is typed as a name, and its empty default reads "none".
+  const bool name = p.type == ParamType::vertex_channel;
+  const std::string fallback = name && p.default_text().empty() ? "none" : p.default_text();
+  std::printf("    %-24s %-5s default %-8s %s\n", flag_of(p.id).c_str(), name ? "name" : param_type_name(p.type),
+              fallback.c_str(), p.range_text().c_str());
 }
 
 int list(const std::vector<std::string>& args) {
