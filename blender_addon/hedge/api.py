@@ -180,7 +180,12 @@ class Batch:
         params = dict(self.params)
         for p in self.op["params"]:
             if p["type"] == "vertex_channel" and p["id"] in params:
-                params[p["id"]] = exchange.vertex_attribute_channel(t.data, params[p["id"]])
+                channel = exchange.vertex_attribute_channel(t.data, params[p["id"]])
+                if channel is None:
+                    known = exchange.vertex_attribute_names(t.data)
+                    raise Error(f"{self.op['id']}: {p['id']}: {t.obj.name} has no vertex group or point attribute "
+                                f"'{params[p['id']]}'" + (f"; it has: {', '.join(known)}" if known else ""))
+                params[p["id"]] = channel
         return soup, params
 
     def read_rest(self):

@@ -304,12 +304,20 @@ GROUP_PREFIX = "vgroup:"
 
 def vertex_attribute_channel(data, name):
     """The channel a parameter naming a vertex attribute means: the vertex group `name` when
-    the object has one (read_vertex_groups), else the point attribute `name`; a name that is
-    neither goes as it is, for the operation to refuse."""
-    if name and name in data.vertex_groups:
+    the object has one (read_vertex_groups), else the point attribute `name`; None when it is
+    neither. An empty name (none) stays empty."""
+    if not name:
+        return name
+    if name in data.vertex_groups:
         return GROUP_PREFIX + name
     channels = {c[0] for c in data.soup["channels"] if c[1] == "vertex"}
-    return ATTRIBUTE_PREFIX + name if ATTRIBUTE_PREFIX + name in channels else name
+    return ATTRIBUTE_PREFIX + name if ATTRIBUTE_PREFIX + name in channels else None
+
+
+def vertex_attribute_names(data):
+    """The names a vertex-attribute parameter may take for this mesh, as Blender shows them."""
+    points = [name for name, _, domain in data.attributes if domain == 'POINT']
+    return data.vertex_groups + [name for name in points if name not in data.vertex_groups]
 
 
 def read_vertex_groups(obj, me, data):

@@ -45,7 +45,7 @@ def text(value):
 
 def refusal_names_parameter(message, op_id, p):
     """A refusal names the operation, the parameter and what is allowed (for a vertex
-    attribute: that the mesh has none of that name)."""
+    attribute: that the mesh has none of that name, in the core's words or the host's)."""
     if p["type"] == "vertex_channel":
-        return f"{op_id}: {p['id']}: the mesh has no vertex attribute" in message
+        return f"{op_id}: {p['id']}: " in message and " has no vertex " in message
     return f"{op_id}: parameter {p['id']} must be {p['range_text']}" in message
