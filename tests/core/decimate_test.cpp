@@ -710,6 +710,19 @@ TEST(Decimate, ShapesWeighInTheError) {
   EXPECT_LT(basis, 1.5 * basis_carried);  // the shape costs the basis little
 }
 
+TEST(Decimate, AShapeLikeTheMeshChangesNothing) {
+  // A key that moves nothing (Blender's fresh "Key 1") leaves the collapses as they were.
+  Soup s = icosphere(4);
+  Mesh plain = build(s).mesh;
+  s.add_channel("shape:Key 1", Domain::vertex, ScalarType::f32, 3);
+  Mesh keyed = build(s).mesh;
+  DecimateOptions o;
+  o.target_ratio = 0.2;
+  decimate(plain, o);
+  decimate(keyed, o);
+  EXPECT_EQ(extract(plain).positions, extract(keyed).positions);
+}
+
 // ---- contracts -----------------------------------------------------------------------------
 
 TEST(Decimate, Deterministic) {

@@ -560,7 +560,9 @@ void Decimator::find_shapes() {
     const PropertyArray& a = vp.at(i);
     if (a.type() != typeid(ChannelArray) || !a.name().starts_with(kShapePrefix)) continue;
     const auto& c = static_cast<const ChannelArray&>(a);
-    if (c.scalar() == ScalarType::f32 && c.components() == 3) shapes_.push_back(&c);
+    // A shape the same as the mesh (all offsets zero) would only repeat its quadrics.
+    const bool moves = std::any_of(c.bytes().begin(), c.bytes().end(), [](std::byte b) { return b != std::byte{0}; });
+    if (c.scalar() == ScalarType::f32 && c.components() == 3 && moves) shapes_.push_back(&c);
   }
   shape_quadrics_.resize(shapes_.size() * m_.vertices_size());
   shape_before_.resize(2 * shapes_.size());
