@@ -82,7 +82,8 @@ struct Seams {
 
 enum class Verdict { delaunay, flip, unselected, feature, seam, blocked, fold };
 
-//! What judge() reads besides the mesh and the options, made once per pass.
+//! What judge() reads besides the mesh and the options, made once per run: flips change
+//! neither the channels the seams compare, nor the vertices, nor which faces are selected.
 struct Context {
   Seams seams;
   detail::WeldedCopies copies;
@@ -130,9 +131,9 @@ double dihedral_angle_degrees(const Mesh& mesh, Edge e) {
   return degrees_between(normal(q.u, q.w, q.c), normal(q.w, q.u, q.d));
 }
 
-DelaunayCensus delaunay_census(const Mesh& mesh, const DelaunayOptions& options) {
+namespace {
+DelaunayCensus census(const Mesh& mesh, const DelaunayOptions& options, const Context& context) {
   DelaunayCensus c;
-  const Context context(mesh, options);
   for (Edge e : mesh.edges()) {
     if (!is_interior_triangle_edge(mesh, e)) continue;
     ++c.interior_edges;
@@ -162,6 +163,11 @@ DelaunayCensus delaunay_census(const Mesh& mesh, const DelaunayOptions& options)
   }
   return c;
 }
+}  // namespace
+
+DelaunayCensus delaunay_census(const Mesh& mesh, const DelaunayOptions& options) {
+  return census(mesh, options, Context(mesh, options));
+}
 
 DelaunayReport make_delaunay(Mesh& mesh, const DelaunayOptions& options, Progress& progress) {
   std::size_t polygons = 0;
@@ -177,8 +183,8 @@ DelaunayReport make_delaunay(Mesh& mesh, const DelaunayOptions& options, Progres
   // Flips happen on a copy, so a cancellation leaves the input as it was.
   std::optional<Mesh> copy;
   Mesh& work = options.keep_input_on_failure ? copy.emplace(mesh) : mesh;
-  report.before = delaunay_census(work, options);
   const Context context(work, options);
+  report.before = census(work, options, context);
 
   std::vector<Index> stack;
   std::vector<char> queued(work.edges_size(), 0);
@@ -215,7 +221,7 @@ DelaunayReport make_delaunay(Mesh& mesh, const DelaunayOptions& options, Progres
     }
   }
   progress.update(0.95, "checking edges");
-  report.after = delaunay_census(work, options);
+  report.after = census(work, options, context);
   if (copy) mesh = std::move(*copy);
   if (report.flips) refresh_normal_channels(mesh, false, true);  // flipped faces have new shapes
   return report;
