@@ -182,7 +182,7 @@ class Batch:
             if p["type"] == "vertex_channel" and p["id"] in params:
                 channel = exchange.vertex_attribute_channel(t.data, params[p["id"]])
                 if channel is None:
-                    known = exchange.vertex_attribute_names(t.data)
+                    known = exchange.vertex_attribute_names(t.data.vertex_groups, t.data.attributes)
                     raise Error(f"{self.op['id']}: {p['id']}: {t.obj.name} has no vertex group or point attribute "
                                 f"'{params[p['id']]}'" + (f"; it has: {', '.join(known)}" if known else ""))
                 params[p["id"]] = channel

@@ -314,10 +314,16 @@ def vertex_attribute_channel(data, name):
     return ATTRIBUTE_PREFIX + name if ATTRIBUTE_PREFIX + name in channels else None
 
 
-def vertex_attribute_names(data):
-    """The names a vertex-attribute parameter may take for this mesh, as Blender shows them."""
-    points = [name for name, _, domain in data.attributes if domain == 'POINT']
-    return data.vertex_groups + [name for name in points if name not in data.vertex_groups]
+# Attribute types that hold one number per element (what a vertex-attribute parameter reads).
+ONE_NUMBER_TYPES = ('FLOAT', 'INT', 'BOOLEAN', 'INT8')
+
+
+def vertex_attribute_names(groups, attributes):
+    """The names a vertex-attribute parameter may take, as Blender shows them: the vertex
+    groups, then the point attributes of one number per vertex ((name, data_type, domain)
+    triples of generic attributes)."""
+    return list(groups) + [name for name, data_type, domain in attributes
+                           if domain == 'POINT' and data_type in ONE_NUMBER_TYPES and name not in groups]
 
 
 def read_vertex_groups(obj, me, data):

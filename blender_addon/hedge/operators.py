@@ -4,7 +4,7 @@
 # the progress bar and Esc to cancel; execute() (redo, scripts) runs synchronously.
 import bpy
 
-from . import api
+from . import api, exchange
 from .native import Error, Cancelled, require_native
 
 INT_LIMIT = 2**31 - 1
@@ -21,9 +21,10 @@ def reap_abandoned():
 
 # What the Blender exchange carries and does not, said in every tooltip of a changing operation.
 EXCHANGE_NOTE = ("Shape keys follow: each key is carried as its offset from the basis (the reference key), "
-                 "interpolated like an attribute (decimation measures its error in every key too), and rebuilt as the new basis plus that offset, so keys "
-                 "relative to other keys and absolute keys deform as before; the same keys stay, with their "
-                 "names, order, settings, drivers and animation. Not carried when the connectivity changes: "
+                 "interpolated like an attribute (decimation measures its error in every key too), and "
+                 "rebuilt as the new basis plus that offset, so keys relative to other keys and absolute "
+                 "keys deform as before; the same keys stay, with their names, order, settings, drivers "
+                 "and animation. Not carried when the connectivity changes: "
                  "custom split normals, loose edges. Vertex group weights are interpolated (weight 0 leaves "
                  "the group); seams, sharp edges and creases follow edges whose ends both come from the "
                  "vertices of such an edge")
@@ -60,9 +61,9 @@ def vertex_attribute_names(self, context, edit_text):
     obj = context.active_object
     if obj is None or obj.type != 'MESH':
         return []
-    names = [g.name for g in obj.vertex_groups]
-    names += [a.name for a in obj.data.attributes if a.domain == 'POINT' and not a.name.startswith(".")
-              and a.data_type in ('FLOAT', 'INT', 'BOOLEAN', 'INT8') and a.name not in names and a.name != "position"]
+    generic = [(a.name, a.data_type, a.domain) for a in obj.data.attributes
+               if not a.name.startswith(".") and a.name not in exchange.RESERVED]
+    names = exchange.vertex_attribute_names([g.name for g in obj.vertex_groups], generic)
     return [n for n in names if edit_text.lower() in n.lower()]
 
 

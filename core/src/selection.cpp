@@ -23,38 +23,13 @@ std::vector<std::uint8_t> flags_of(const ChannelArray* channel, std::size_t n) {
   return out;
 }
 
-template <class T>
-double number_at(const std::byte* element) {
-  T x;
-  std::memcpy(&x, element, sizeof x);
-  return static_cast<double>(x);
-}
-
+// The first number of element i, whatever the channel's scalar type.
 double scalar_at(const ChannelArray& channel, std::size_t i) {
-  const std::byte* e = channel.element(i);
-  switch (channel.scalar()) {
-    case ScalarType::f32:
-      return number_at<float>(e);
-    case ScalarType::f64:
-      return number_at<double>(e);
-    case ScalarType::i8:
-      return number_at<std::int8_t>(e);
-    case ScalarType::u8:
-      return number_at<std::uint8_t>(e);
-    case ScalarType::i16:
-      return number_at<std::int16_t>(e);
-    case ScalarType::u16:
-      return number_at<std::uint16_t>(e);
-    case ScalarType::i32:
-      return number_at<std::int32_t>(e);
-    case ScalarType::u32:
-      return number_at<std::uint32_t>(e);
-    case ScalarType::i64:
-      return number_at<std::int64_t>(e);
-    case ScalarType::u64:
-      return number_at<std::uint64_t>(e);
-  }
-  return 0;
+  return with_scalar(channel.scalar(), [&]<class T>() {
+    T x;
+    std::memcpy(&x, channel.element(i), sizeof x);
+    return static_cast<double>(x);
+  });
 }
 }  // namespace
 

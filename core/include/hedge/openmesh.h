@@ -105,34 +105,6 @@ bool for_each_scalar(F&& f) {
          f.template operator()<long long>() || f.template operator()<unsigned long long>();
 }
 
-//! The C++ type of a channel scalar, for f.template operator()<C>().
-template <class F>
-decltype(auto) with_scalar(ScalarType scalar, F&& f) {
-  switch (scalar) {
-    case ScalarType::f32:
-      return f.template operator()<float>();
-    case ScalarType::f64:
-      return f.template operator()<double>();
-    case ScalarType::i8:
-      return f.template operator()<std::int8_t>();
-    case ScalarType::u8:
-      return f.template operator()<std::uint8_t>();
-    case ScalarType::i16:
-      return f.template operator()<std::int16_t>();
-    case ScalarType::u16:
-      return f.template operator()<std::uint16_t>();
-    case ScalarType::i32:
-      return f.template operator()<std::int32_t>();
-    case ScalarType::u32:
-      return f.template operator()<std::uint32_t>();
-    case ScalarType::i64:
-      return f.template operator()<std::int64_t>();
-    case ScalarType::u64:
-      return f.template operator()<std::uint64_t>();
-  }
-  throw Error("openmesh: unknown channel scalar type");
-}
-
 //! Property value type for N components of S: S itself or OpenMesh::VectorT<S, N>.
 template <class S, int N>
 using value_type_for = std::conditional_t<N == 1, S, OpenMesh::VectorT<S, N>>;

@@ -26,6 +26,34 @@ enum class ScalarType : std::uint8_t { f32, f64, i8, u8, i16, u16, i32, u32, i64
 std::size_t scalar_size(ScalarType type);
 const char* scalar_name(ScalarType type);
 
+//! The C++ type of a channel scalar, for f.template operator()<C>().
+template <class F>
+decltype(auto) with_scalar(ScalarType scalar, F&& f) {
+  switch (scalar) {
+    case ScalarType::f32:
+      return f.template operator()<float>();
+    case ScalarType::f64:
+      return f.template operator()<double>();
+    case ScalarType::i8:
+      return f.template operator()<std::int8_t>();
+    case ScalarType::u8:
+      return f.template operator()<std::uint8_t>();
+    case ScalarType::i16:
+      return f.template operator()<std::int16_t>();
+    case ScalarType::u16:
+      return f.template operator()<std::uint16_t>();
+    case ScalarType::i32:
+      return f.template operator()<std::int32_t>();
+    case ScalarType::u32:
+      return f.template operator()<std::uint32_t>();
+    case ScalarType::i64:
+      return f.template operator()<std::int64_t>();
+    case ScalarType::u64:
+      return f.template operator()<std::uint64_t>();
+  }
+  throw Error("unknown channel scalar type");
+}
+
 //! Type-erased array of one property: what containers need to keep arrays in step.
 class PropertyArray {
  public:
