@@ -324,8 +324,7 @@ Face Mesh::add_face(std::span<const Halfedge> halfedges) {
   if (auto dup = std::adjacent_find(corners.begin(), corners.end()); dup != corners.end())
     throw fail("the chain passes vertex " + id(dup->idx()) + " twice");
   for (std::size_t i = 0; i < n; ++i)
-    if (next(halfedges[i]) != halfedges[(i + 1) % n])
-      throw fail("the half-edges are not one whole boundary loop");
+    if (next(halfedges[i]) != halfedges[(i + 1) % n]) throw fail("the half-edges are not one whole boundary loop");
 
   Face f = new_face();
   for (Halfedge h : halfedges) set_face(h, f);
@@ -440,7 +439,7 @@ Halfedge Mesh::split_edge_triangles(Edge e, Vertex v) {
   if (!is_boundary(e) && to_vertex(next(halfedge(e, 0))) == to_vertex(next(halfedge(e, 1))))
     throw Error("split_edge_triangles: the two triangles of edge " + id(e.idx()) +
                 " share their third corner; connecting it twice would double an edge");
-  Halfedge h = split_edge(e, v);  // v0 -> v
+  Halfedge h = split_edge(e, v);    // v0 -> v
   Halfedge o1 = opposite(next(h));  // v2 -> v
   if (!is_boundary(h)) split_face_by_edge(*this, h, next(next(h)));
   if (!is_boundary(o1)) split_face_by_edge(*this, o1, next(next(o1)));
@@ -528,7 +527,9 @@ void Mesh::collapse(Halfedge h) {
   collapse_unchecked(h);
 }
 
-void Mesh::collapse_unchecked(Halfedge h) {
+void Mesh::collapse_unchecked(Halfedge h) { collapse_unchecked(h, deleted_); }
+
+void Mesh::collapse_unchecked(Halfedge h, Deletions& tally) {
 #ifndef NDEBUG
   if (const char* why = collapse_refusal(*this, h))
     throw Error(refused("collapse_unchecked", "half-edge " + id(h.idx()), why) + " (the caller's precondition)");
@@ -552,8 +553,8 @@ void Mesh::collapse_unchecked(Halfedge h) {
   if (fo.is_valid() && halfedge(fo) == o) set_halfedge(fo, op);
   if (halfedge(v1) == o) set_halfedge(v1, hn);
   set_halfedge(v0, Halfedge());
-  mark_deleted(v0);
-  mark_deleted(edge(h));
+  mark_deleted(v0, tally);
+  mark_deleted(edge(h), tally);
 
   // A 2-gon g -> next(g) -> g: keep next(g)'s edge (the one at v1), put it where
   // opposite(g) was, and drop g's edge and face.
@@ -571,8 +572,8 @@ void Mesh::collapse_unchecked(Halfedge h) {
       set_halfedge(b, ok);
       adjust_outgoing_halfedge(b);
     }
-    if (loop_face.is_valid()) mark_deleted(loop_face);
-    mark_deleted(edge(g));
+    if (loop_face.is_valid()) mark_deleted(loop_face, tally);
+    mark_deleted(edge(g), tally);
   };
   if (next(next(hp)) == hp) remove_loop(hp);
   // The first removal may have deleted on's edge (when fo also held hp's outer side).

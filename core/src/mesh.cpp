@@ -48,7 +48,7 @@ Vertex Mesh::new_vertex() {
   vertex_halfedge_.push_back(Halfedge());
   positions_.emplace_back();
   vprops_.push_back();
-  if (deleted_vertices_) vdeleted_.push_back(false);
+  if (!vdeleted_.empty()) vdeleted_.push_back(0);
   return Vertex(static_cast<Index>(vertices_size() - 1));
 }
 
@@ -59,7 +59,7 @@ Halfedge Mesh::new_edge(Vertex from, Vertex to) {
   hprops_.push_back();
   hprops_.push_back();
   eprops_.push_back();
-  if (deleted_edges_) edeleted_.push_back(false);
+  if (!edeleted_.empty()) edeleted_.push_back(0);
   return Halfedge(static_cast<Index>(halfedges_size() - 2));
 }
 
@@ -67,7 +67,7 @@ Face Mesh::new_face() {
   check_capacity(faces_size() + 1, "faces");
   face_halfedge_.push_back(Halfedge());
   fprops_.push_back();
-  if (deleted_faces_) fdeleted_.push_back(false);
+  if (!fdeleted_.empty()) fdeleted_.push_back(0);
   return Face(static_cast<Index>(faces_size() - 1));
 }
 
@@ -92,9 +92,9 @@ void Mesh::resize_unset(std::size_t vertices, std::size_t edges, std::size_t fac
   eprops_.resize(edges);
   face_halfedge_.resize(faces);
   fprops_.resize(faces);
-  if (deleted_vertices_) vdeleted_.resize(vertices, false);
-  if (deleted_edges_) edeleted_.resize(edges, false);
-  if (deleted_faces_) fdeleted_.resize(faces, false);
+  if (!vdeleted_.empty()) vdeleted_.resize(vertices, 0);
+  if (!edeleted_.empty()) edeleted_.resize(edges, 0);
+  if (!fdeleted_.empty()) fdeleted_.resize(faces, 0);
 #ifndef NDEBUG
   // Debug builds poison what was left unset, so a builder that misses a field fails validate().
   const Index poison = 0x5a5a5a5au;
@@ -171,25 +171,37 @@ Edge Mesh::find_edge(Vertex a, Vertex b) const {
   return h.is_valid() ? edge(h) : Edge();
 }
 
-void Mesh::mark_deleted(Vertex v) {
+void Mesh::mark_deleted(Vertex v, Deletions& tally) {
   if (is_deleted(v)) return;
-  if (vdeleted_.size() != vertices_size()) vdeleted_.assign(vertices_size(), false);
-  vdeleted_[v.idx()] = true;
-  ++deleted_vertices_;
+  if (vdeleted_.size() != vertices_size()) vdeleted_.assign(vertices_size(), 0);
+  vdeleted_[v.idx()] = 1;
+  ++tally.vertices;
 }
 
-void Mesh::mark_deleted(Edge e) {
+void Mesh::mark_deleted(Edge e, Deletions& tally) {
   if (is_deleted(e)) return;
-  if (edeleted_.size() != edges_size()) edeleted_.assign(edges_size(), false);
-  edeleted_[e.idx()] = true;
-  ++deleted_edges_;
+  if (edeleted_.size() != edges_size()) edeleted_.assign(edges_size(), 0);
+  edeleted_[e.idx()] = 1;
+  ++tally.edges;
 }
 
-void Mesh::mark_deleted(Face f) {
+void Mesh::mark_deleted(Face f, Deletions& tally) {
   if (is_deleted(f)) return;
-  if (fdeleted_.size() != faces_size()) fdeleted_.assign(faces_size(), false);
-  fdeleted_[f.idx()] = true;
-  ++deleted_faces_;
+  if (fdeleted_.size() != faces_size()) fdeleted_.assign(faces_size(), 0);
+  fdeleted_[f.idx()] = 1;
+  ++tally.faces;
+}
+
+void Mesh::prepare_deletion_marks() {
+  if (vdeleted_.size() != vertices_size()) vdeleted_.assign(vertices_size(), 0);
+  if (edeleted_.size() != edges_size()) edeleted_.assign(edges_size(), 0);
+  if (fdeleted_.size() != faces_size()) fdeleted_.assign(faces_size(), 0);
+}
+
+void Mesh::add_deletions(const Deletions& tally) {
+  deleted_.vertices += tally.vertices;
+  deleted_.edges += tally.edges;
+  deleted_.faces += tally.faces;
 }
 
 void Mesh::delete_face(Face f) {
@@ -248,7 +260,8 @@ void Mesh::delete_vertex(Vertex v) {
 namespace {
 // Old -> new index for live elements, new -> old for the gather; keeps relative order.
 template <class IsDeleted>
-void compaction_maps(std::size_t n, IsDeleted is_deleted, std::vector<Index>& old_to_new, std::vector<Index>& new_to_old) {
+void compaction_maps(std::size_t n, IsDeleted is_deleted, std::vector<Index>& old_to_new,
+                     std::vector<Index>& new_to_old) {
   old_to_new.assign(n, kInvalidIndex);
   new_to_old.clear();
   for (std::size_t i = 0; i < n; ++i)
@@ -270,9 +283,12 @@ void gather(Array& data, const std::vector<Index>& new_to_old) {
 GarbageMaps Mesh::garbage_collect() {
   GarbageMaps maps;
   std::vector<Index> vkeep, ekeep, hkeep, fkeep;
-  compaction_maps(vertices_size(), [&](Index i) { return is_deleted(Vertex(i)); }, maps.vertices, vkeep);
-  compaction_maps(edges_size(), [&](Index i) { return is_deleted(Edge(i)); }, maps.edges, ekeep);
-  compaction_maps(faces_size(), [&](Index i) { return is_deleted(Face(i)); }, maps.faces, fkeep);
+  compaction_maps(
+      vertices_size(), [&](Index i) { return is_deleted(Vertex(i)); }, maps.vertices, vkeep);
+  compaction_maps(
+      edges_size(), [&](Index i) { return is_deleted(Edge(i)); }, maps.edges, ekeep);
+  compaction_maps(
+      faces_size(), [&](Index i) { return is_deleted(Face(i)); }, maps.faces, fkeep);
   maps.halfedges.assign(halfedges_size(), kInvalidIndex);
   hkeep.reserve(2 * ekeep.size());
   for (Index e : ekeep) {
@@ -308,15 +324,15 @@ GarbageMaps Mesh::garbage_collect() {
   vdeleted_.clear();
   edeleted_.clear();
   fdeleted_.clear();
-  deleted_vertices_ = deleted_edges_ = deleted_faces_ = 0;
+  deleted_ = {};
   return maps;
 }
 
 std::size_t Mesh::heap_bytes() const {
   return halfedges_.capacity() * sizeof(HalfedgeRecord) + vertex_halfedge_.capacity() * sizeof(Halfedge) +
-         face_halfedge_.capacity() * sizeof(Halfedge) + positions_.capacity() * sizeof(Point) +
-         (vdeleted_.capacity() + edeleted_.capacity() + fdeleted_.capacity()) / 8 + vprops_.heap_bytes() +
-         hprops_.heap_bytes() + eprops_.heap_bytes() + fprops_.heap_bytes();
+         face_halfedge_.capacity() * sizeof(Halfedge) + positions_.capacity() * sizeof(Point) + vdeleted_.capacity() +
+         edeleted_.capacity() + fdeleted_.capacity() + vprops_.heap_bytes() + hprops_.heap_bytes() +
+         eprops_.heap_bytes() + fprops_.heap_bytes();
 }
 
 }  // namespace hedge

@@ -134,10 +134,10 @@ class Mesh {
 
   // ---- sizes -------------------------------------------------------------------------
   //! Live element counts (deleted ones excluded).
-  std::size_t n_vertices() const { return vertices_size() - deleted_vertices_; }
-  std::size_t n_halfedges() const { return halfedges_size() - 2 * deleted_edges_; }
-  std::size_t n_edges() const { return edges_size() - deleted_edges_; }
-  std::size_t n_faces() const { return faces_size() - deleted_faces_; }
+  std::size_t n_vertices() const { return vertices_size() - deleted_.vertices; }
+  std::size_t n_halfedges() const { return halfedges_size() - 2 * deleted_.edges; }
+  std::size_t n_edges() const { return edges_size() - deleted_.edges; }
+  std::size_t n_faces() const { return faces_size() - deleted_.faces; }
   //! Array sizes, deleted elements included: the bound for handle indices.
   std::size_t vertices_size() const { return vertex_halfedge_.size(); }
   std::size_t halfedges_size() const { return halfedges_.size(); }
@@ -331,11 +331,12 @@ class Mesh {
   const PropertyContainer& face_properties() const { return fprops_; }
 
   // ---- deletion and garbage collection -------------------------------------------------
-  bool is_deleted(Vertex v) const { return deleted_vertices_ && vdeleted_[v.idx()]; }
-  bool is_deleted(Edge e) const { return deleted_edges_ && edeleted_[e.idx()]; }
+  // The marks exist once something was deleted (or prepare_deletion_marks() made them).
+  bool is_deleted(Vertex v) const { return !vdeleted_.empty() && vdeleted_[v.idx()]; }
+  bool is_deleted(Edge e) const { return !edeleted_.empty() && edeleted_[e.idx()]; }
   bool is_deleted(Halfedge h) const { return is_deleted(edge(h)); }
-  bool is_deleted(Face f) const { return deleted_faces_ && fdeleted_[f.idx()]; }
-  bool has_garbage() const { return deleted_vertices_ || deleted_edges_ || deleted_faces_; }
+  bool is_deleted(Face f) const { return !fdeleted_.empty() && fdeleted_[f.idx()]; }
+  bool has_garbage() const { return deleted_.vertices || deleted_.edges || deleted_.faces; }
   //! Removes f; its edges that end up with no face on either side are deleted too, and
   //! vertices left without edges are deleted (pmp semantics). A vertex whose fan this
   //! leaves with two gaps is non-manifold (validate() says so): callers that delete
@@ -417,6 +418,19 @@ class Mesh {
   //! costs as much as the collapse). Precondition: is_collapse_ok(h); otherwise the mesh is
   //! left broken. Debug builds check the precondition and throw Error when it fails.
   void collapse_unchecked(Halfedge h);
+  //! Counts of deleted elements.
+  struct Deletions {
+    std::size_t vertices = 0, edges = 0, faces = 0;
+  };
+  //! collapse_unchecked(h) for several threads at once, each collapsing where no other
+  //! reads or writes (no two collapses whose closed one-rings share a vertex): deletions are
+  //! counted in the caller's `tally`, which add_deletions() folds into the mesh afterwards.
+  //! Precondition besides collapse_unchecked(h)'s: prepare_deletion_marks() was called, so
+  //! that marking an element resizes no array. Until add_deletions(), n_vertices() and the
+  //! like count the deleted elements as present.
+  void collapse_unchecked(Halfedge h, Deletions& tally);
+  void prepare_deletion_marks();
+  void add_deletions(const Deletions& tally);
 
   //! Splits f into triangles by a fan of new edges from corner 0 (no geometry involved;
   //! the triangulate operation chooses diagonals by shape); O(corners). When a diagonal
@@ -440,9 +454,12 @@ class Mesh {
     if (auto* a = c.get<T>(name)) return Property<H, T>(a);
     return Property<H, T>(c.add<T>(name, def));
   }
-  void mark_deleted(Vertex v);
-  void mark_deleted(Edge e);
-  void mark_deleted(Face f);
+  void mark_deleted(Vertex v, Deletions& tally);
+  void mark_deleted(Edge e, Deletions& tally);
+  void mark_deleted(Face f, Deletions& tally);
+  void mark_deleted(Vertex v) { mark_deleted(v, deleted_); }
+  void mark_deleted(Edge e) { mark_deleted(e, deleted_); }
+  void mark_deleted(Face f) { mark_deleted(f, deleted_); }
 
   template <class T>
   using Array = std::vector<T, detail::UnsetAllocator<T>>;
@@ -451,8 +468,9 @@ class Mesh {
   Array<Halfedge> face_halfedge_;
   std::vector<Point> positions_;
   PropertyContainer vprops_, hprops_, eprops_, fprops_;
-  std::vector<bool> vdeleted_, edeleted_, fdeleted_;
-  std::size_t deleted_vertices_ = 0, deleted_edges_ = 0, deleted_faces_ = 0;
+  // Bytes, not bits: threads collapsing side by side mark neighbouring elements.
+  std::vector<std::uint8_t> vdeleted_, edeleted_, fdeleted_;
+  Deletions deleted_;
 };
 
 // ---- inline definitions of the iterators -----------------------------------------------

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <memory>
 #include <numbers>
 #include <optional>
 #include <vector>
@@ -244,6 +245,16 @@ constexpr double kMaxWeightStrength = 1000;
 // 10% more mean error and no change in the Hausdorff distance on the dragon.
 constexpr double kPull = 0.01;
 
+// Collapsing in regions (Decimator::collapse_in_regions): from this many faces on, in this
+// many regions, while more than kTailShare of the faces to remove are left (and at least
+// kMinPhase collapses' worth).
+constexpr std::size_t kRegionsMinFaces = 50000;
+constexpr std::size_t kRegions = 32;
+constexpr double kTailShare = 0.02;
+constexpr std::size_t kMinPhase = 2048;
+constexpr float kNoCost = std::numeric_limits<float>::infinity();
+constexpr std::uint16_t kNoRegion = 0xffff;
+
 class Decimator {
  public:
   Decimator(Mesh& mesh, const DecimateOptions& options, Progress& progress)
@@ -271,6 +282,14 @@ class Decimator {
   }
   std::uint8_t classify(Vertex v) const;
   void fill_heap();
+  // The error of collapsing h, placed as c says: a mean squared distance.
+  double error_sq_of(Halfedge h, const Candidate& c) const {
+    const PackedQuadric& q0 = vd_[m_.from_vertex(h).idx()].quadric;
+    const PackedQuadric& q1 = vd_[m_.to_vertex(h).idx()].quadric;
+    double weight = double(q0.weight) + double(q1.weight);
+    if (!shapes_.empty()) weight += shapes_weight(m_.from_vertex(h), m_.to_vertex(h));
+    return weight > 0 ? double(c.cost) / weight : 0;
+  }
 
   // ---- evaluation ----------------------------------------------------------------------
   Vec3d local(Vertex v) const { return (to_double(m_.position(v)) - center_) * inv_scale_; }
@@ -295,13 +314,12 @@ class Decimator {
   }
   bool evaluate(Edge e, Candidate& c) const;
   double boundary_shift(Halfedge h0, const Vec3d& p) const;
-  // Evaluates e and queues it under a new version (any older entry becomes stale); an edge
-  // without any legal placement just loses its entries.
-  void requeue(Edge e) {
-    const std::uint8_t v = ++version_[e.idx()];
-    Candidate c;
-    if (evaluate(e, c)) queue_.push(EdgeQueue::key(c.cost, v), e.idx());
-  }
+  struct Scratch;
+  struct Worker;
+  // Evaluates e and queues it in w's queue under a new version (any older entry becomes
+  // stale) when it costs at most w.max_cost; an edge without any legal placement just loses
+  // its entries. During the phases its cost is kept too.
+  void requeue(Edge e, Worker& w);
 
   // ---- fetching ahead ------------------------------------------------------------------
   // Each collapse starts with cache misses: the popped edge lies anywhere in the mesh, and its
@@ -309,18 +327,8 @@ class Decimator {
   // about four times in five) has its neighbourhood fetched while the current collapse runs,
   // one dependent step per call to fetch_ahead(), so that each step's loads have arrived
   // when the next one reads them. Only hints: a wrong guess costs some memory traffic.
-  void start_fetch_ahead(Index edge) {
-    ahead_stage_ = 0;
-    if (edge == kInvalidIndex) return;
-    ahead_edge_ = Edge(edge);
-    ahead_stage_ = 1;
-    m_.prefetch(Mesh::halfedge(ahead_edge_, 0));
-    detail::prefetch(&version_[edge]);
-  }
-  void fetch_ahead();
-  Edge ahead_edge_;
-  int ahead_stage_ = 0;  // 0: nothing to fetch
-  Halfedge ahead_ring_[2], ahead_ring_start_[2];
+  void start_fetch_ahead(Scratch& s, Index edge) const;
+  void fetch_ahead(Scratch& s) const;
 
   // ---- collapsing ----------------------------------------------------------------------
   // Why a collapse is refused, in the order tested.
@@ -339,21 +347,34 @@ class Decimator {
     kWeld,          // extract()'s weld of build()'s copies would give an edge of v1 a third face
     kFold,          // a triangle would turn too far or become degenerate
     kQuality,       // the worst triangle would fall below min_quality
+    kRegion,        // during a phase: a ring leaves the region
     kRefusals
   };
-  Refusal check(Halfedge h, const Point& target) const;
-  bool triangle_ok(const Vec3d& old_apex, const Vec3d& new_apex, const Vec3d& a, const Vec3d& b) const;
-  void collapse(Halfedge h, const Candidate& c);
+  Refusal check(Halfedge h, const Point& target, Scratch& s, std::uint16_t region = kNoRegion) const;
+  bool triangle_ok(const Vec3d& old_apex, const Vec3d& new_apex, const Vec3d& a, const Vec3d& b, Scratch& s) const;
+  // What a collapse changed, for the queue to follow up.
+  struct Collapsed {
+    Vertex kept;
+    Vertex reclassified[2];  // vl, vr when their seam flags changed (their edges need measuring)
+    Edge doomed[5];          // the collapsed edge and one of each merged pair
+    int removed_faces;
+  };
+  // The collapse itself: the mesh, the quadrics, attributes and flags. It reads and writes
+  // only the closed one-rings of h's ends, so collapses whose rings are apart may run on
+  // several threads at once, each with its own scratch and tally.
+  Collapsed apply_collapse(Halfedge h, const Candidate& c, Scratch& s, Mesh::Deletions& tally);
+  // apply_collapse() and what follows in w's queue; returns the number of faces removed.
+  int collapse(Halfedge h, const Candidate& c, Worker& w);
   // Barycentric coordinates of a point in a triangle, by its corner half-edges.
   struct Blend {
     Halfedge corner[3];
     float weight[3] = {0, 0, 0};  // non-negative, normalized in blend_element
   };
   Blend locate(const Vec3d& p, std::span<const Face> faces) const;
-  void locate_vertex(const Candidate& c);
-  void gather_wedges(Halfedge h, const Point& target);
-  void blend_wedges(Vertex kept);
-  void interpolate_vertex(Vertex removed, Vertex kept, const Candidate& c);
+  void locate_vertex(const Candidate& c, Scratch& s) const;
+  void gather_wedges(Halfedge h, const Point& target, Scratch& s) const;
+  void blend_wedges(Vertex kept, const Scratch& s);
+  void interpolate_vertex(Vertex removed, Vertex kept, const Candidate& c, Scratch& s);
 
   Mesh& m_;
   const DecimateOptions& opt_;
@@ -372,7 +393,6 @@ class Decimator {
   // quadric per vertex and shape about the vertex's place in that shape, vertex-major.
   std::vector<const ChannelArray*> shapes_;
   std::vector<PackedQuadric> shape_quadrics_;
-  std::vector<Vec3d> shape_before_;  // scratch of collapse(): both ends' places in each shape
   bool has_boundary_ = false;
 
   // Everything evaluate() reads about a vertex, in one cache line: its quadric (about its
@@ -388,14 +408,11 @@ class Decimator {
   // then take the page faults of first touching the array instead of one zero-filling thread.
   std::vector<VertexData, detail::UnsetAllocator<VertexData>> vd_;
   std::vector<std::uint8_t> version_;  // of each edge's current queue entry: one byte, stays in cache
-  EdgeQueue queue_{&version_};
   struct RingEntry {
     Vertex vertex;  // a neighbour, in counter-clockwise order
     Face face;      // the face between it and the next neighbour (invalid: a hole)
     Vec3d position;
   };
-  mutable std::vector<RingEntry> ring0_, ring1_;  // scratch of check()
-  mutable double worst_new_ = 1, worst_old_ = 1;  // triangle quality around the collapse being tested
 
   std::vector<ChannelArray*> corner_channels_;  // host per-corner channels (seams are judged on these)
   // Vertex properties; host channels (not build()'s internal arrays) are interpolated in
@@ -406,17 +423,60 @@ class Decimator {
   };
   std::vector<VertexArray> vertex_arrays_;
   bool vertex_channels_ = false;
-  std::vector<Face> faces_scratch_;
-  Index vertex_blend_index_[3];
-  float vertex_blend_weight_[3];
-  int vertex_blend_size_ = 0;
 
-  // Scratch of one collapse (reused: no allocation per collapse).
-  std::vector<Face> wedge_faces_[2];     // faces whose corner at the kept vertex joins wedge l / r
-  std::vector<std::byte> wedge_values_;  // new corner values: [wedge l, wedge r] per channel
-  bool wedge_present_[2] = {false, false};
-  Index interp_index_[2];
-  float interp_weight_[2];
+  // What testing and making one collapse needs besides the mesh, reused from one collapse to
+  // the next (no allocation per collapse), and the fetching ahead of the next one.
+  struct Scratch {
+    std::vector<RingEntry> ring0, ring1;  // check(): both ends' rings
+    double worst_new = 1, worst_old = 1;  // triangle quality around the collapse being tested
+    std::vector<Face> faces;
+    Index vertex_blend_index[3];
+    float vertex_blend_weight[3];
+    int vertex_blend_size = 0;
+    std::vector<Face> wedge_faces[2];     // faces whose corner at the kept vertex joins wedge l / r
+    std::vector<std::byte> wedge_values;  // new corner values: [wedge l, wedge r] per channel
+    bool wedge_present[2] = {false, false};
+    Index interp_index[2];
+    float interp_weight[2];
+    std::vector<Vec3d> shape_before;  // both ends' places in each shape
+    Edge ahead_edge;
+    int ahead_stage = 0;  // 0: nothing to fetch
+    Halfedge ahead_ring[2], ahead_ring_start[2];
+  };
+  // One collapsing loop: the queue over the whole mesh, or a region's during a phase.
+  struct Worker {
+    explicit Worker(const std::vector<std::uint8_t>* versions) : queue(versions) {}
+    EdgeQueue queue;
+    Scratch scratch;
+    Mesh::Deletions tally;
+    std::uint16_t region = kNoRegion;  // collapses only inside it; kNoRegion: anywhere
+    float max_cost = kNoCost;          // edges above this wait for a later phase
+    std::size_t face_budget = 0;       // a region's share of the faces to remove
+    std::size_t collapses = 0, removed_faces = 0;
+    double max_error_sq = 0;
+    bool refused_for_error = false;
+    std::vector<Index> remeasure;  // edges across the region's border whose ends changed
+  };
+  Worker serial_{&version_};
+
+  // ---- collapsing in regions -----------------------------------------------------------
+  // While much is left to remove, collapses run in phases, each region of the mesh on its
+  // own thread: a region collapses, greedily from its own queue, its edges below the phase's
+  // cost threshold whose ends' one-rings lie wholly inside it, so regions never meet and the
+  // result does not depend on which thread ran which region. Regions are runs of a Morton
+  // order of the vertices, fixed in number (not one per thread) and shifted by half a region
+  // every other phase, so that edges near one phase's borders are inside the next one's.
+  // Every region works on a small part of the mesh, which stays in cache better than the
+  // one queue over everything. The queue over the whole mesh takes over for the last
+  // collapses, which hit the exact target and relax the limits when needed.
+  void measure_edges();
+  void collapse_in_regions();
+  std::size_t collapse_phase(int phase, const std::vector<std::uint16_t>& cell,
+                             const std::vector<std::size_t>& cell_start);
+  void collapse_region(Worker& w);
+  std::vector<float> cost_;            // per edge during the phases; kNoCost: no candidate
+  std::vector<std::uint16_t> region_;  // per vertex during a phase
+  std::vector<Worker> workers_;        // one per region
 
   std::size_t faces_ = 0;
   std::size_t target_ = 0;
@@ -565,7 +625,6 @@ void Decimator::find_shapes() {
     if (c.scalar() == ScalarType::f32 && c.components() == 3 && moves) shapes_.push_back(&c);
   }
   shape_quadrics_.resize(shapes_.size() * m_.vertices_size());
-  shape_before_.resize(2 * shapes_.size());
 }
 
 // The error of a collapse in the other shapes: the merged vertex at p (relative to a) takes
@@ -777,10 +836,19 @@ bool Decimator::evaluate(Edge e, Candidate& c) const {
 // The current collapse may change the neighbourhood being fetched between two steps; the
 // records of deleted elements keep in-range indices, so such a walk only reads stale values
 // (and fetches the wrong lines), and it stops after 20 steps whatever it finds.
-void Decimator::fetch_ahead() {
-  if (ahead_stage_ == 0) return;
-  const Halfedge h0 = Mesh::halfedge(ahead_edge_, 0), o0 = Mesh::opposite(h0);
-  if (ahead_stage_ == 1) {
+void Decimator::start_fetch_ahead(Scratch& s, Index edge) const {
+  s.ahead_stage = 0;
+  if (edge == kInvalidIndex) return;
+  s.ahead_edge = Edge(edge);
+  s.ahead_stage = 1;
+  m_.prefetch(Mesh::halfedge(s.ahead_edge, 0));
+  detail::prefetch(&version_[edge]);
+}
+
+void Decimator::fetch_ahead(Scratch& s) const {
+  if (s.ahead_stage == 0) return;
+  const Halfedge h0 = Mesh::halfedge(s.ahead_edge, 0), o0 = Mesh::opposite(h0);
+  if (s.ahead_stage == 1) {
     // The ends and the triangles' other half-edges and faces. The rings start from the
     // edge's own half-edges (each is outgoing from one end), not from halfedge(v), which
     // would be one more load to wait for.
@@ -790,9 +858,9 @@ void Decimator::fetch_ahead() {
       detail::prefetch(&vd_[v.idx()]);
       m_.prefetch(v);
       if (const Face f = m_.face(x); f.is_valid()) m_.prefetch(f), m_.prefetch(m_.next(x)), m_.prefetch(m_.prev(x));
-      ahead_ring_[i] = ahead_ring_start_[i] = x;
+      s.ahead_ring[i] = s.ahead_ring_start[i] = x;
     }
-  } else if (ahead_stage_ == 2) {
+  } else if (s.ahead_stage == 2) {
     // The opposite corners, from the half-edges stage 1 fetched.
     for (Halfedge x : {h0, o0})
       if (m_.face(x).is_valid()) detail::prefetch(&vd_[m_.to_vertex(m_.next(x)).idx()]);
@@ -800,31 +868,27 @@ void Decimator::fetch_ahead() {
   // One step around both rings: the neighbour's data, and the next half-edge's record.
   bool more = false;
   for (int i = 0; i < 2; ++i) {
-    Halfedge& x = ahead_ring_[i];
+    Halfedge& x = s.ahead_ring[i];
     if (!x.is_valid()) continue;
     const Vertex w = m_.to_vertex(x);
     detail::prefetch(&m_.position(w));
     detail::prefetch(&vd_[w.idx()]);
     detail::prefetch(&version_[Mesh::edge(x).idx()]);
     x = m_.ccw_rotated(x);
-    if (x == ahead_ring_start_[i]) {
+    if (x == s.ahead_ring_start[i]) {
       x = Halfedge();
       continue;
     }
     m_.prefetch(x);
     more = true;
   }
-  ahead_stage_ = more && ahead_stage_ < 20 ? ahead_stage_ + 1 : 0;
+  s.ahead_stage = more && s.ahead_stage < 20 ? s.ahead_stage + 1 : 0;
 }
 
-void Decimator::fill_heap() {
-  version_.assign(m_.edges_size(), 0);
-  queue_.clear();
-  // Every edge is measured on all threads (evaluate() only reads), then queued in edge
-  // order, so the queue does not depend on the thread count.
+// Every edge is measured on all threads (evaluate() only reads).
+void Decimator::measure_edges() {
   const std::size_t n = m_.edges_size();
-  constexpr std::uint32_t kNone = 0xffffffffu;  // above every key of a finite cost
-  std::vector<std::uint32_t> keys(n);
+  cost_.resize(n);
   parallel_for(n, opt_.threads, [&](std::size_t begin, std::size_t end) {
     constexpr std::size_t kAhead = 8;  // edges: the half-edges stream in, the end vertices do not
     for (std::size_t i = begin; i < end; ++i) {
@@ -833,16 +897,214 @@ void Decimator::fill_heap() {
           detail::prefetch(&vd_[m_.vertex(Edge(static_cast<Index>(i + kAhead)), side).idx()]);
       const Edge e(static_cast<Index>(i));
       Candidate c;
-      keys[i] = !m_.is_deleted(e) && evaluate(e, c) ? EdgeQueue::key(c.cost, 0) : kNone;
+      cost_[i] = !m_.is_deleted(e) && evaluate(e, c) ? c.cost : kNoCost;
     }
   });
-  progress_.update(0.1, "measuring edges");
-  for (std::size_t i = 0; i < n; ++i)
-    if (keys[i] != kNone) queue_.push(keys[i], static_cast<Index>(i));
+}
+
+// The queue, from the costs as the phases left them, in edge order, so that it does not
+// depend on the thread count.
+void Decimator::fill_heap() {
+  version_.assign(m_.edges_size(), 0);
+  serial_.queue.clear();
+  for (std::size_t i = 0; i < cost_.size(); ++i)
+    if (cost_[i] != kNoCost && !m_.is_deleted(Edge(static_cast<Index>(i))))
+      serial_.queue.push(EdgeQueue::key(cost_[i], 0), static_cast<Index>(i));
+  cost_ = {};
+}
+
+void Decimator::requeue(Edge e, Worker& w) {
+  const std::uint8_t v = ++version_[e.idx()];
+  Candidate c;
+  const bool found = evaluate(e, c);
+  if (!cost_.empty()) cost_[e.idx()] = found ? c.cost : kNoCost;
+  if (found && c.cost <= w.max_cost) w.queue.push(EdgeQueue::key(c.cost, v), e.idx());
+}
+
+namespace {
+// The bits of a non-negative float order like the float; a cost that rounding made negative
+// counts as zero.
+std::uint32_t cost_bits(float cost) { return std::bit_cast<std::uint32_t>(std::max(cost, 0.0f)); }
+
+// A 15-bit Morton code of a point of the normalized frame (the bounding box centred on the
+// origin, its diagonal 1): 5 bits per axis, interleaved, of the grid moved by `offset`
+// (wrapping around).
+std::uint16_t morton_cell(const Vec3f& p, double offset) {
+  std::uint16_t code = 0;
+  for (int axis = 0; axis < 3; ++axis) {
+    const double x = double(p[axis]) + 0.5 + offset;
+    const int q = std::clamp(int((x - std::floor(x)) * 32), 0, 31);
+    for (int bit = 0; bit < 5; ++bit) code |= std::uint16_t(((q >> bit) & 1) << (3 * bit + axis));
+  }
+  return code;
+}
+constexpr std::size_t kCells = std::size_t(1) << 15;
+}  // namespace
+
+void Decimator::collapse_in_regions() {
+  m_.prepare_deletion_marks();
+  version_.assign(m_.edges_size(), 0);
+  const std::size_t vertices = m_.vertices_size();
+  // Two orders of the vertices' Morton cells, on grids a third of the box apart, so that
+  // the great planes of one order's octree, where regions always part, are not the other's:
+  // each vertex's cell, and where each cell starts in its order.
+  std::vector<std::uint16_t> cells[2];
+  std::vector<std::size_t> cell_starts[2];
+  for (int grid = 0; grid < 2; ++grid) {
+    std::vector<std::uint16_t>& cell = cells[grid];
+    cell.resize(vertices);
+    parallel_for(vertices, opt_.threads, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) cell[i] = morton_cell(vd_[i].position, grid / 3.0);
+    });
+    std::vector<std::size_t>& cell_start = cell_starts[grid];
+    cell_start.assign(kCells + 1, 0);
+    for (std::size_t i = 0; i < vertices; ++i) ++cell_start[cell[i] + 1];
+    for (std::size_t c = 0; c < kCells; ++c) cell_start[c + 1] += cell_start[c];
+  }
+  region_.resize(vertices);
+  workers_.clear();
+  for (std::size_t r = 0; r < kRegions; ++r) workers_.emplace_back(&version_);
+
+  const std::size_t start_faces = faces_, to_remove = faces_ - target_;
+  const std::size_t tail = std::max(kMinPhase, std::size_t(kTailShare * double(to_remove)));
+  for (int phase = 0; faces_ - target_ > tail; ++phase) {
+    const std::size_t made = collapse_phase(phase, cells[phase % 2], cell_starts[phase % 2]);
+    progress_.update(0.1 + 0.85 * double(start_faces - faces_) / double(to_remove), "collapsing edges");
+    if (made < kMinPhase) break;
+  }
+  workers_.clear();
+  region_ = {};
+}
+
+std::size_t Decimator::collapse_phase(int phase, const std::vector<std::uint16_t>& cell,
+                                      const std::vector<std::size_t>& cell_start) {
+  // 1. The regions: runs of cells of about equal numbers of vertices, shifted by half a run
+  // every other phase of the same grid.
+  const std::size_t vertices = cell.size();
+  const std::size_t shift = phase % 4 >= 2 ? vertices / (2 * kRegions) : 0;
+  std::vector<std::uint16_t> region_of_cell(kCells);
+  for (std::size_t c = 0; c < kCells; ++c)
+    region_of_cell[c] = std::uint16_t((cell_start[c] + shift) * kRegions / vertices % kRegions);
+  parallel_for(vertices, opt_.threads, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) region_[i] = region_of_cell[cell[i]];
+  });
+
+  // 2. The threshold: about a quarter of the faces still to remove, in collapses, cost less
+  // among the edges inside a region (each collapse removes two faces, and makes more cheap
+  // edges).
+  constexpr int kShift = 16;
+  constexpr std::size_t kBuckets = std::size_t(1) << (32 - kShift);
+  std::vector<std::uint32_t> histogram(kBuckets, 0);
+  auto inside = [&](std::size_t i) {
+    const Edge e(static_cast<Index>(i));
+    return region_[m_.vertex(e, 0).idx()] == region_[m_.vertex(e, 1).idx()];
+  };
+  for (std::size_t i = 0; i < cost_.size(); ++i)
+    if (cost_[i] != kNoCost && inside(i)) ++histogram[cost_bits(cost_[i]) >> kShift];
+  const std::size_t wanted = (faces_ - target_) / 4;
+  std::size_t below = 0, last_bucket = 0;
+  for (std::size_t b = 0; b < kBuckets && below < wanted; ++b) {
+    below += histogram[b];
+    if (histogram[b]) last_bucket = b;
+  }
+  const float max_cost = std::bit_cast<float>(std::uint32_t(((last_bucket + 1) << kShift) - 1));
+
+  // 3. Each region's queue: its edges below the threshold with both ends inside it.
+  for (Worker& w : workers_) {
+    w.queue.clear();
+    w.region = std::uint16_t(&w - workers_.data());
+    w.max_cost = max_cost;
+    w.tally = {};
+    w.collapses = w.removed_faces = 0;
+    w.max_error_sq = 0;
+    w.refused_for_error = false;
+    w.remeasure.clear();
+  }
+  std::vector<std::size_t> candidates(kRegions, 0);
+  for (std::size_t i = 0; i < cost_.size(); ++i) {
+    if (cost_[i] == kNoCost || cost_[i] > max_cost || !inside(i)) continue;
+    const Edge e(static_cast<Index>(i));
+    const std::uint16_t r = region_[m_.vertex(e, 0).idx()];
+    workers_[r].queue.push(EdgeQueue::key(cost_[i], version_[i]), e.idx());
+    ++candidates[r];
+  }
+  // Each region may remove its share of the faces still to remove, by its candidates, so
+  // that the regions together never pass the target.
+  std::size_t total = 0;
+  for (std::size_t n : candidates) total += n;
+  if (total == 0) return 0;
+  for (Worker& w : workers_)
+    w.face_budget = std::size_t(double(faces_ - target_) * double(candidates[w.region]) / double(total));
+
+  // 4. The regions, on all threads; each thread takes the next region left.
+  std::atomic<std::size_t> next{0};
+  parallel_for(
+      resolve_thread_count(opt_.threads), opt_.threads,
+      [&](std::size_t begin, std::size_t end) {
+        for (std::size_t t = begin; t < end; ++t)
+          for (std::size_t r; (r = next.fetch_add(1)) < kRegions;) collapse_region(workers_[r]);
+      },
+      1);
+
+  // 5. Together again.
+  std::size_t made = 0;
+  for (Worker& w : workers_) {
+    m_.add_deletions(w.tally);
+    faces_ -= w.removed_faces;
+    made += w.collapses;
+    report_.collapses += w.collapses;
+    max_error_sq_seen_ = std::max(max_error_sq_seen_, w.max_error_sq);
+    refused_for_error_ = refused_for_error_ || w.refused_for_error;
+    for (Index i : w.remeasure) {
+      Candidate c;
+      cost_[i] = !m_.is_deleted(Edge(i)) && evaluate(Edge(i), c) ? c.cost : kNoCost;
+    }
+  }
+  return made;
+}
+
+// A region's greedy loop: its cheapest edge first, while it costs at most the threshold and
+// the region's share of faces lasts.
+void Decimator::collapse_region(Worker& w) {
+  const double max_error_sq = opt_.max_error * opt_.max_error;
+  while (!w.queue.empty() && w.removed_faces + 2 <= w.face_budget) {
+    const EdgeQueue::Entry entry = w.queue.pop();
+    if (entry.edge == kInvalidIndex) continue;
+    const Edge e(entry.edge);
+    if (EdgeQueue::version(entry.key) != version_[e.idx()] || m_.is_deleted(e)) continue;
+    ++version_[e.idx()];
+    start_fetch_ahead(w.scratch, w.queue.peek());
+    Candidate c;
+    if (!evaluate(e, c)) {
+      cost_[e.idx()] = kNoCost;
+      continue;
+    }
+    cost_[e.idx()] = c.cost;
+    if (c.cost > w.max_cost) continue;
+    const Halfedge h = Mesh::halfedge(e, c.side);
+    const double error_sq = error_sq_of(h, c);
+    if (max_error_sq > 0 && error_sq > max_error_sq) {
+      w.refused_for_error = true;
+      cost_[e.idx()] = kNoCost;
+      continue;
+    }
+    fetch_ahead(w.scratch);
+    const Refusal why = check(h, c.position, w.scratch, w.region);
+    if (why == kRegion) continue;  // its cost stays: a later phase's regions lie elsewhere
+    if (why != kLegal) {
+      cost_[e.idx()] = kNoCost;
+      continue;
+    }
+    fetch_ahead(w.scratch);
+    w.removed_faces += std::size_t(collapse(h, c, w));
+    ++w.collapses;
+    w.max_error_sq = std::max(w.max_error_sq, error_sq);
+  }
 }
 
 // Rotation limit and degeneracy of one triangle (apex, a, b) when its apex moves.
-bool Decimator::triangle_ok(const Vec3d& old_apex, const Vec3d& new_apex, const Vec3d& a, const Vec3d& b) const {
+bool Decimator::triangle_ok(const Vec3d& old_apex, const Vec3d& new_apex, const Vec3d& a, const Vec3d& b,
+                            Scratch& s) const {
   if (opt_.prevent_flips) {
     const Vec3d n_old = cross(a - old_apex, b - old_apex);
     const Vec3d ea = a - new_apex, eb = b - new_apex;
@@ -855,8 +1117,8 @@ bool Decimator::triangle_ok(const Vec3d& old_apex, const Vec3d& new_apex, const 
     if (old_sq > 0 && dot(n_old, n_new) < cos_max_normal_change_ * std::sqrt(old_sq * new_sq)) return false;
   }
   if (opt_.min_quality > 0) {
-    worst_new_ = std::min(worst_new_, triangle_quality(new_apex, a, b));
-    worst_old_ = std::min(worst_old_, triangle_quality(old_apex, a, b));
+    s.worst_new = std::min(s.worst_new, triangle_quality(new_apex, a, b));
+    s.worst_old = std::min(s.worst_old, triangle_quality(old_apex, a, b));
   }
   return true;
 }
@@ -864,9 +1126,16 @@ bool Decimator::triangle_ok(const Vec3d& old_apex, const Vec3d& new_apex, const 
 // The link condition (Dey et al.), pmp's and OpenMesh's guards against pinching and
 // pillows, and the geometric checks on every triangle that survives around both ends.
 // Stricter than Mesh::is_collapse_ok(), in O(valence).
-Decimator::Refusal Decimator::check(Halfedge h, const Point& target) const {
+Decimator::Refusal Decimator::check(Halfedge h, const Point& target, Scratch& s, std::uint16_t region) const {
   const Halfedge o = Mesh::opposite(h);
   const Vertex v0 = m_.to_vertex(o), v1 = m_.to_vertex(h);
+  // First, during a phase: nothing outside the region may be read, another thread may be
+  // changing it. The faces around v0 and v1 hold only vertices of this region or of the
+  // border, which no region changes.
+  if (region != kNoRegion)
+    for (Vertex v : {v0, v1})
+      for (Halfedge x : m_.outgoing(v))
+        if (region_[m_.to_vertex(x).idx()] != region) return kRegion;
   const Face fl = m_.face(h), fr = m_.face(o);
   Vertex vl, vr;
   if (fl.is_valid()) {
@@ -895,8 +1164,8 @@ Decimator::Refusal Decimator::check(Halfedge h, const Point& target) const {
   // The two rings, in order: each entry is a neighbour and the face between it and the next.
   // Both rings are walked at once: each step waits for the half-edge the previous one
   // named, so two walks side by side overlap their cache misses instead of queueing them.
-  ring0_.clear();
-  ring1_.clear();
+  s.ring0.clear();
+  s.ring1.clear();
   const Halfedge start0 = m_.halfedge(v0), start1 = m_.halfedge(v1);
   Halfedge x0 = start0, x1 = start1;
   bool more0 = true, more1 = true;  // neither end is isolated: both have h
@@ -910,17 +1179,17 @@ Decimator::Refusal Decimator::check(Halfedge h, const Point& target) const {
     more = x != start;
   };
   while (more0 || more1) {
-    if (more0) step(x0, start0, more0, ring0_);
-    if (more1) step(x1, start1, more1, ring1_);
+    if (more0) step(x0, start0, more0, s.ring0);
+    if (more1) step(x1, start1, more1, s.ring1);
   }
   // Link condition: the only common neighbours are vl and vr; and a second edge v0 - v1
   // would become a loop. The rings are short, so plain scans beat marking arrays.
   int edges_to_v1 = 0;
-  for (const RingEntry& r : ring0_) edges_to_v1 += r.vertex == v1;
+  for (const RingEntry& r : s.ring0) edges_to_v1 += r.vertex == v1;
   if (edges_to_v1 > 1) return kDoubleEdge;
-  for (const RingEntry& r1 : ring1_) {
+  for (const RingEntry& r1 : s.ring1) {
     if (r1.vertex == vl || r1.vertex == vr || r1.vertex == v0) continue;
-    for (const RingEntry& r0 : ring0_)
+    for (const RingEntry& r0 : s.ring0)
       if (r0.vertex == r1.vertex) return kLink;
   }
   // The same through extract()'s weld of build()'s copies.
@@ -930,11 +1199,11 @@ Decimator::Refusal Decimator::check(Halfedge h, const Point& target) const {
   // triangle worse than both the threshold and the worst triangle it replaces, so slivers of
   // the input do not freeze the regions around them.
   const Vec3d p_new = to_double(target);
-  worst_new_ = worst_old_ = 1;
+  s.worst_new = s.worst_old = 1;
   if (opt_.min_quality > 0) {
     const Vec3d p0 = to_double(m_.position(v0)), p1 = to_double(m_.position(v1));
-    if (vl.is_valid()) worst_old_ = std::min(worst_old_, triangle_quality(p0, p1, to_double(m_.position(vl))));
-    if (vr.is_valid()) worst_old_ = std::min(worst_old_, triangle_quality(p1, p0, to_double(m_.position(vr))));
+    if (vl.is_valid()) s.worst_old = std::min(s.worst_old, triangle_quality(p0, p1, to_double(m_.position(vl))));
+    if (vr.is_valid()) s.worst_old = std::min(s.worst_old, triangle_quality(p1, p0, to_double(m_.position(vr))));
   }
   auto faces_ok = [&](Vertex v, std::vector<RingEntry>& ring) {
     for (RingEntry& r : ring) r.position = to_double(m_.position(r.vertex));
@@ -943,13 +1212,13 @@ Decimator::Refusal Decimator::check(Halfedge h, const Point& target) const {
     for (std::size_t i = 0; i < n; ++i) {
       const Face f = ring[i].face;
       if (!f.is_valid() || f == fl || f == fr) continue;
-      if (!triangle_ok(apex, p_new, ring[i].position, ring[i + 1 == n ? 0 : i + 1].position)) return false;
+      if (!triangle_ok(apex, p_new, ring[i].position, ring[i + 1 == n ? 0 : i + 1].position, s)) return false;
     }
     return true;
   };
-  if (!faces_ok(v0, ring0_)) return kFold;
-  if (!faces_ok(v1, ring1_)) return kFold;
-  if (worst_new_ < opt_.min_quality && worst_new_ < worst_old_) return kQuality;
+  if (!faces_ok(v0, s.ring0)) return kFold;
+  if (!faces_ok(v1, s.ring1)) return kFold;
+  if (s.worst_new < opt_.min_quality && s.worst_new < s.worst_old) return kQuality;
   return kLegal;
 }
 
@@ -1017,13 +1286,13 @@ void blend_element(const ChannelArray& c, std::byte* dst, const std::byte* const
 // corners continuous with v1's corner there (wedge l); likewise on the right (wedge r).
 // Corners in other wedges keep their values. Each merged wedge takes the value at the new
 // vertex interpolated inside its own chart's triangles, computed now, while they exist.
-void Decimator::gather_wedges(Halfedge h, const Point& target) {
+void Decimator::gather_wedges(Halfedge h, const Point& target, Scratch& s) const {
   const Halfedge o = Mesh::opposite(h);
   const Face fl = m_.face(h), fr = m_.face(o);
-  wedge_faces_[0].clear();
-  wedge_faces_[1].clear();
-  wedge_present_[0] = fl.is_valid();
-  wedge_present_[1] = fr.is_valid();
+  s.wedge_faces[0].clear();
+  s.wedge_faces[1].clear();
+  s.wedge_present[0] = fl.is_valid();
+  s.wedge_present[1] = fr.is_valid();
 
   // Walks the fan from `start` (an outgoing half-edge whose face holds corner `corner`),
   // rotating one way, while corners stay equal; stops at a hole or at `stop`.
@@ -1040,32 +1309,32 @@ void Decimator::gather_wedges(Halfedge h, const Point& target) {
     }
   };
   if (fl.is_valid()) {
-    walk(h, m_.prev(h), true, fr, wedge_faces_[0]);   // around v0, from fl towards fr
-    walk(m_.next(h), h, false, fr, wedge_faces_[0]);  // around v1, from fl towards fr
+    walk(h, m_.prev(h), true, fr, s.wedge_faces[0]);   // around v0, from fl towards fr
+    walk(m_.next(h), h, false, fr, s.wedge_faces[0]);  // around v1, from fl towards fr
   }
   if (fr.is_valid()) {
-    walk(m_.next(o), o, false, fl, wedge_faces_[1]);  // around v0, from fr towards fl
-    walk(o, m_.prev(o), true, fl, wedge_faces_[1]);   // around v1, from fr towards fl
+    walk(m_.next(o), o, false, fl, s.wedge_faces[1]);  // around v0, from fr towards fl
+    walk(o, m_.prev(o), true, fl, s.wedge_faces[1]);   // around v1, from fr towards fl
   }
 
   std::size_t bytes = 0;
   for (const ChannelArray* c : corner_channels_) bytes += 2 * c->stride();
-  wedge_values_.resize(bytes);
+  s.wedge_values.resize(bytes);
   const Vec3d p = to_double(target);
   // Across a non-seam edge both sides are one wedge: one value, bit for bit, or the two
   // sides would drift apart by rounding and read as a new seam.
   const bool one_wedge = fl.is_valid() && fr.is_valid() && corners_equal(m_.prev(h), o) && corners_equal(h, m_.prev(o));
   for (int side = 0; side < 2; ++side) {
-    if (!wedge_present_[side]) continue;
+    if (!s.wedge_present[side]) continue;
     if (side == 1 && one_wedge) {
       std::size_t offset = 0;
       for (const ChannelArray* c : corner_channels_) {
-        std::memcpy(wedge_values_.data() + offset + c->stride(), wedge_values_.data() + offset, c->stride());
+        std::memcpy(s.wedge_values.data() + offset + c->stride(), s.wedge_values.data() + offset, c->stride());
         offset += 2 * c->stride();
       }
       continue;
     }
-    std::vector<Face>& faces = wedge_faces_[side];
+    std::vector<Face>& faces = s.wedge_faces[side];
     faces.push_back(side == 0 ? fl : fr);  // the chart's triangles; the removed one last
     Blend blend = locate(p, faces);
     faces.pop_back();
@@ -1078,23 +1347,23 @@ void Decimator::gather_wedges(Halfedge h, const Point& target) {
     for (const ChannelArray* c : corner_channels_) {
       const std::byte* src[3] = {c->element(blend.corner[0].idx()), c->element(blend.corner[1].idx()),
                                  c->element(blend.corner[2].idx())};
-      blend_element(*c, wedge_values_.data() + offset + side * c->stride(), src, blend.weight);
+      blend_element(*c, s.wedge_values.data() + offset + side * c->stride(), src, blend.weight);
       offset += 2 * c->stride();
     }
   }
 }
 
 // After the collapse: every corner of a merged wedge takes the wedge's new value.
-void Decimator::blend_wedges(Vertex kept) {
+void Decimator::blend_wedges(Vertex kept, const Scratch& s) {
   for (int side = 0; side < 2; ++side) {
-    if (!wedge_present_[side]) continue;
-    for (Face f : wedge_faces_[side]) {
+    if (!s.wedge_present[side]) continue;
+    for (Face f : s.wedge_faces[side]) {
       if (m_.is_deleted(f)) continue;
       Halfedge x = m_.halfedge(f);
       while (m_.to_vertex(x) != kept) x = m_.next(x);
       std::size_t offset = 0;
       for (ChannelArray* c : corner_channels_) {
-        std::memcpy(c->element(x.idx()), wedge_values_.data() + offset + side * c->stride(), c->stride());
+        std::memcpy(c->element(x.idx()), s.wedge_values.data() + offset + side * c->stride(), c->stride());
         offset += 2 * c->stride();
       }
     }
@@ -1105,120 +1374,140 @@ void Decimator::blend_wedges(Vertex kept) {
 // triangle holding it (among the faces around both ends, gathered by check()), located
 // before the collapse while those triangles exist; internal arrays (build()'s provenance)
 // by the generic interpolation along the edge.
-void Decimator::locate_vertex(const Candidate& c) {
-  faces_scratch_.clear();
-  for (const RingEntry& r : ring0_) faces_scratch_.push_back(r.face);
-  for (const RingEntry& r : ring1_) faces_scratch_.push_back(r.face);
-  const Blend b = locate(to_double(c.position), faces_scratch_);
-  vertex_blend_size_ = 0;
+void Decimator::locate_vertex(const Candidate& c, Scratch& s) const {
+  s.faces.clear();
+  for (const RingEntry& r : s.ring0) s.faces.push_back(r.face);
+  for (const RingEntry& r : s.ring1) s.faces.push_back(r.face);
+  const Blend b = locate(to_double(c.position), s.faces);
+  s.vertex_blend_size = 0;
   if (!b.corner[0].is_valid()) return;
   for (int i = 0; i < 3; ++i) {
-    vertex_blend_index_[i] = m_.to_vertex(b.corner[i]).idx();
-    vertex_blend_weight_[i] = b.weight[i];
+    s.vertex_blend_index[i] = m_.to_vertex(b.corner[i]).idx();
+    s.vertex_blend_weight[i] = b.weight[i];
   }
-  vertex_blend_size_ = 3;
+  s.vertex_blend_size = 3;
 }
 
-void Decimator::interpolate_vertex(Vertex removed, Vertex kept, const Candidate& c) {
+void Decimator::interpolate_vertex(Vertex removed, Vertex kept, const Candidate& c, Scratch& s) {
   if (vertex_arrays_.empty()) return;
-  interp_index_[0] = removed.idx();
-  interp_index_[1] = kept.idx();
-  interp_weight_[0] = 1 - c.kept_weight;
-  interp_weight_[1] = c.kept_weight;
+  s.interp_index[0] = removed.idx();
+  s.interp_index[1] = kept.idx();
+  s.interp_weight[0] = 1 - c.kept_weight;
+  s.interp_weight[1] = c.kept_weight;
   const bool copies = copies_.is_copy(removed) || copies_.is_copy(kept);
   for (const VertexArray& a : vertex_arrays_) {
     // Where a copy goes, the kept vertex keeps its own source: taking the copy's would weld
     // it to the copy's other copies.
     if (copies && !a.channel && a.array->is_internal()) continue;
-    if (a.channel && vertex_blend_size_ == 3 && a.channel->stride() <= 256) {
+    if (a.channel && s.vertex_blend_size == 3 && a.channel->stride() <= 256) {
       // Deleted vertices keep their rows until garbage collection: the removed end's too.
       std::byte out[256];
-      const std::byte* src[3] = {a.channel->element(vertex_blend_index_[0]), a.channel->element(vertex_blend_index_[1]),
-                                 a.channel->element(vertex_blend_index_[2])};
-      blend_element(*a.channel, out, src, vertex_blend_weight_);
+      const std::byte* src[3] = {a.channel->element(s.vertex_blend_index[0]),
+                                 a.channel->element(s.vertex_blend_index[1]),
+                                 a.channel->element(s.vertex_blend_index[2])};
+      blend_element(*a.channel, out, src, s.vertex_blend_weight);
       std::memcpy(a.channel->element(kept.idx()), out, a.channel->stride());
     } else {
-      a.array->interpolate(kept.idx(), std::span<const Index>(interp_index_, 2),
-                           std::span<const float>(interp_weight_, 2));
+      a.array->interpolate(kept.idx(), std::span<const Index>(s.interp_index, 2),
+                           std::span<const float>(s.interp_weight, 2));
     }
   }
 }
 
-void Decimator::collapse(Halfedge h, const Candidate& c) {
+Decimator::Collapsed Decimator::apply_collapse(Halfedge h, const Candidate& c, Scratch& s, Mesh::Deletions& tally) {
   const Halfedge o = Mesh::opposite(h);
   const Vertex v0 = m_.to_vertex(o), v1 = m_.to_vertex(h);
   const Face fl = m_.face(h), fr = m_.face(o);
   const Vertex vl = fl.is_valid() ? m_.to_vertex(m_.next(h)) : Vertex();
   const Vertex vr = fr.is_valid() ? m_.to_vertex(m_.next(o)) : Vertex();
-  const int removed_faces = int(fl.is_valid()) + int(fr.is_valid());
+  Collapsed done{
+      v1,
+      {},
+      {Mesh::edge(h), Mesh::edge(m_.next(h)), Mesh::edge(m_.prev(h)), Mesh::edge(m_.next(o)), Mesh::edge(m_.prev(o))},
+      int(fl.is_valid()) + int(fr.is_valid())};
 
-  // The edges that may go: the collapsed one and one of each merged pair.
-  const Edge doomed[5] = {Mesh::edge(h), Mesh::edge(m_.next(h)), Mesh::edge(m_.prev(h)), Mesh::edge(m_.next(o)),
-                          Mesh::edge(m_.prev(o))};
-  if (!corner_channels_.empty()) gather_wedges(h, c.position);
+  if (!corner_channels_.empty()) gather_wedges(h, c.position, s);
   // Located before the collapse, while the old triangles exist; written after it.
-  if (vertex_channels_) locate_vertex(c);
+  if (vertex_channels_) locate_vertex(c, s);
   // check() has just passed: it implies Mesh::is_collapse_ok() on a triangle mesh (its link
   // test, ears, pinches and 3-edge holes are the same; a tetrahedron's apex has valence 3,
   // which kValenceLeft/Right refuse), so the mesh's own test, which costs as much as the
   // collapse, is not run again.
-  m_.collapse_unchecked(h);
-  fetch_ahead();
-  // Queue entries of deleted edges go stale.
-  for (Edge d : doomed)
-    if (m_.is_deleted(d)) ++version_[d.idx()];
+  m_.collapse_unchecked(h, tally);
+  fetch_ahead(s);
   m_.position(v1) = c.position;
 #ifdef HEDGE_DECIMATE_DEBUG
   if (Validation val = validate(m_); !val.ok)
-    throw Error("decimate debug: collapse " + std::to_string(report_.collapses) + " of " + std::to_string(v0.idx()) +
-                " into " + std::to_string(v1.idx()) + " broke the mesh: " + val.message);
+    throw Error("decimate debug: collapse of " + std::to_string(v0.idx()) + " into " + std::to_string(v1.idx()) +
+                " broke the mesh: " + val.message);
 #endif
   // The merged quadric, moved to be about the new position.
   VertexData &d0 = vd_[v0.idx()], &d1 = vd_[v1.idx()];
   const Vec3d c0 = to_double(d0.position), c1 = to_double(d1.position);
   const Vec3d moved = local(v1);
   d1.quadric.store((d1.quadric.unpack() + d0.quadric.unpack().shifted(c1 - c0)).shifted(moved - c1));
+  s.shape_before.resize(2 * shapes_.size());
   for (std::size_t k = 0; k < shapes_.size(); ++k) {
-    shape_before_[2 * k] = shape_at(k, v0);
-    shape_before_[2 * k + 1] = shape_at(k, v1);
+    s.shape_before[2 * k] = shape_at(k, v0);
+    s.shape_before[2 * k + 1] = shape_at(k, v1);
   }
   d1.position = to_float(moved);
-  interpolate_vertex(v0, v1, c);
+  interpolate_vertex(v0, v1, c, s);
   // Each shape's merged quadric, about the new vertex's place there (its blended offset).
   for (std::size_t k = 0; k < shapes_.size(); ++k) {
-    const Vec3d k0 = shape_before_[2 * k], k1 = shape_before_[2 * k + 1];
+    const Vec3d k0 = s.shape_before[2 * k], k1 = s.shape_before[2 * k + 1];
     PackedQuadric& q1 = shape_quadrics_[v1.idx() * shapes_.size() + k];
     q1.store((q1.unpack() + shape_quadric(k, v0).shifted(k1 - k0)).shifted(shape_at(k, v1) - k1));
   }
-  if (!corner_channels_.empty()) blend_wedges(v1);
+  if (!corner_channels_.empty()) blend_wedges(v1, s);
 
-  d1.valence = static_cast<std::uint16_t>(d0.valence + d1.valence - 2 - removed_faces);
+  d1.valence = static_cast<std::uint16_t>(d0.valence + d1.valence - 2 - done.removed_faces);
   if (vl.is_valid()) --vd_[vl.idx()].valence;
   if (vr.is_valid()) --vd_[vr.idx()].valence;
-  faces_ -= removed_faces;
 
   // The kept vertex is on the boundary when either end was, and stays locked when it was (the
   // removed end never is); vl and vr keep their status.
   d1.flags = (d0.flags | d1.flags) & (kBoundary | kLocked);
   if (seam_mode_) {
     d1.flags |= classify(v1);
-    for (Vertex v : {vl, vr}) {
+    for (int i = 0; i < 2; ++i) {
+      const Vertex v = i == 0 ? vl : vr;
       if (!v.is_valid()) continue;
       const std::uint8_t f = std::uint8_t((vd_[v.idx()].flags & ~kSeamBits) | classify(v));
-      if (f != vd_[v.idx()].flags) {
-        vd_[v.idx()].flags = f;
-        for (Halfedge x : m_.outgoing(v)) requeue(Mesh::edge(x));
-      }
+      if (f == vd_[v.idx()].flags) continue;
+      vd_[v.idx()].flags = f;
+      done.reclassified[i] = v;
     }
   }
-  // Every edge at the kept vertex changed: evaluate them now, while their half-edges are in
-  // cache (one sweep to fetch the neighbours' data, one to evaluate), rather than when they
-  // surface cold.
-  for (Halfedge x : m_.outgoing(v1)) detail::prefetch(&vd_[m_.to_vertex(x).idx()]);
-  for (Halfedge x : m_.outgoing(v1)) {
-    requeue(Mesh::edge(x));
-    fetch_ahead();
+  return done;
+}
+
+int Decimator::collapse(Halfedge h, const Candidate& c, Worker& w) {
+  const Collapsed done = apply_collapse(h, c, w.scratch, w.tally);
+  // Queue entries of deleted edges go stale.
+  for (Edge d : done.doomed)
+    if (m_.is_deleted(d)) {
+      ++version_[d.idx()];
+      if (!cost_.empty()) cost_[d.idx()] = kNoCost;
+    }
+  // A region measures again only its own edges; the others wait for the phase's end.
+  for (Vertex v : done.reclassified)
+    if (v.is_valid())
+      for (Halfedge x : m_.outgoing(v)) {
+        if (w.region == kNoRegion || region_[m_.to_vertex(x).idx()] == w.region)
+          requeue(Mesh::edge(x), w);
+        else
+          w.remeasure.push_back(Mesh::edge(x).idx());
+      }
+  // Every edge at the kept vertex changed (its neighbours are all in the region): evaluate
+  // them now, while their half-edges are in cache (one sweep to fetch the neighbours' data,
+  // one to evaluate), rather than when they surface cold.
+  for (Halfedge x : m_.outgoing(done.kept)) detail::prefetch(&vd_[m_.to_vertex(x).idx()]);
+  for (Halfedge x : m_.outgoing(done.kept)) {
+    requeue(Mesh::edge(x), w);
+    fetch_ahead(w.scratch);
   }
+  return done.removed_faces;
 }
 
 DecimateReport Decimator::run() {
@@ -1257,6 +1546,9 @@ DecimateReport Decimator::run() {
   find_corner_channels();
   classify_vertices();
   progress_.update(0.05, "measuring edges");
+  measure_edges();
+  progress_.update(0.1, "measuring edges");
+  if (faces_ >= kRegionsMinFaces) collapse_in_regions();
   fill_heap();
 
   const double max_error_sq = opt_.max_error * opt_.max_error;
@@ -1265,7 +1557,7 @@ DecimateReport Decimator::run() {
   std::size_t collapses_since_fill = 0, refills = 0;
   std::size_t steps = 0;
   while (faces_ > target_) {
-    if (queue_.empty()) {
+    if (serial_.queue.empty()) {
       // Edges refused earlier (fold-overs, link condition) may be legal now that their
       // neighbourhood changed: queue every edge again while that still helps. Past the
       // preferred limit on turning triangles, only flips stay forbidden.
@@ -1282,29 +1574,25 @@ DecimateReport Decimator::run() {
         refills = 0;
       }
       collapses_since_fill = 0;
-      for (Edge e : m_.edges()) requeue(e);
+      for (Edge e : m_.edges()) requeue(e, serial_);
       continue;
     }
     if ((++steps & 0x3ff) == 0)
       progress_.update(0.1 + 0.85 * double(start_faces - faces_) / double(to_remove), "collapsing edges");
 
-    const EdgeQueue::Entry entry = queue_.pop();
+    const EdgeQueue::Entry entry = serial_.queue.pop();
     if (entry.edge == kInvalidIndex) continue;
     const Edge e(entry.edge);
     if (EdgeQueue::version(entry.key) != version_[e.idx()] || m_.is_deleted(e)) continue;
     ++version_[e.idx()];  // out of the queue now
-    start_fetch_ahead(queue_.peek());
+    start_fetch_ahead(serial_.scratch, serial_.queue.peek());
     // Its placement is computed again rather than stored, which keeps the per-edge state to
     // one byte; the vertex data it reads is needed for the collapse anyway.
     Candidate c;
     if (!evaluate(e, c)) continue;
 
     const Halfedge h = Mesh::halfedge(e, c.side);
-    const PackedQuadric& q0 = vd_[m_.from_vertex(h).idx()].quadric;
-    const PackedQuadric& q1 = vd_[m_.to_vertex(h).idx()].quadric;
-    double weight = double(q0.weight) + double(q1.weight);
-    if (!shapes_.empty()) weight += shapes_weight(m_.from_vertex(h), m_.to_vertex(h));
-    const double error_sq = weight > 0 ? double(c.cost) / weight : 0;
+    const double error_sq = error_sq_of(h, c);
     if (max_error_sq > 0 && error_sq > max_error_sq) {
       refused_for_error_ = true;
       continue;
@@ -1315,10 +1603,10 @@ DecimateReport Decimator::run() {
       if (!has_boundary_) break;
       continue;
     }
-    fetch_ahead();
-    if (check(h, c.position) != kLegal) continue;
-    fetch_ahead();
-    collapse(h, c);
+    fetch_ahead(serial_.scratch);
+    if (check(h, c.position, serial_.scratch) != kLegal) continue;
+    fetch_ahead(serial_.scratch);
+    faces_ -= std::size_t(collapse(h, c, serial_));
     ++report_.collapses;
     ++collapses_since_fill;
     max_error_sq_seen_ = std::max(max_error_sq_seen_, error_sq);
@@ -1333,7 +1621,7 @@ DecimateReport Decimator::run() {
         ++no_candidate;
         continue;
       }
-      const Refusal why = check(Mesh::halfedge(e, c.side), c.position);
+      const Refusal why = check(Mesh::halfedge(e, c.side), c.position, serial_.scratch);
       if (why == kLegal)
         ++ok;
       else
@@ -1345,6 +1633,7 @@ DecimateReport Decimator::run() {
     std::fprintf(stderr, "\n");
   }
 #endif
+  m_.add_deletions(serial_.tally);
   progress_.update(0.95, "compacting");
   m_.garbage_collect();
   report_.faces_after = m_.n_faces();
