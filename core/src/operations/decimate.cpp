@@ -142,6 +142,7 @@ class EdgeQueue {
   };
 
   bool empty() const { return size_ == 0; }
+  std::size_t size() const { return size_; }
   void clear() {
     for (auto& b : buckets_) b.clear();
     size_ = 0;
@@ -249,9 +250,11 @@ constexpr double kPull = 0.01;
 // many regions, while more than kTailShare of the faces to remove are left (and at least
 // kMinPhase collapses' worth).
 constexpr std::size_t kRegionsMinFaces = 50000;
-constexpr std::size_t kRegions = 32;
+constexpr std::size_t kRegionVertices = 16384;  // about this many vertices per region, in at least
+constexpr std::size_t kMinRegions = 32;         // this many regions
 constexpr double kTailShare = 0.02;
 constexpr std::size_t kMinPhase = 2048;
+constexpr std::size_t kThresholdShare = 4;  // the threshold: (faces to remove) / this cost less
 constexpr float kNoCost = std::numeric_limits<float>::infinity();
 constexpr std::uint16_t kNoRegion = 0xffff;
 
@@ -270,7 +273,8 @@ class Decimator {
   void find_shapes();
   void compute_quadrics();
   template <class Where>
-  void add_face_planes(std::vector<Quadric>& sum, std::size_t begin, std::size_t end, Where where) const;
+  Quadric face_planes(Vertex v, Where where) const;
+  bool add_boundary_planes(Vertex v, Quadric& q) const;
   void find_corner_channels();
   void classify_vertices();
   //! Lets collapses meet extract()'s weld of build()'s copies from now on; false when they
@@ -471,12 +475,19 @@ class Decimator {
   // collapses, which hit the exact target and relax the limits when needed.
   void measure_edges();
   void collapse_in_regions();
-  std::size_t collapse_phase(int phase, const std::vector<std::uint16_t>& cell,
+  std::size_t collapse_phase(int phase, const std::vector<std::uint32_t>& cell,
                              const std::vector<std::size_t>& cell_start);
   void collapse_region(Worker& w);
   std::vector<float> cost_;            // per edge during the phases; kNoCost: no candidate
   std::vector<std::uint16_t> region_;  // per vertex during a phase
   std::vector<Worker> workers_;        // one per region
+  std::size_t regions_ = 0;
+  struct Queued {
+    std::uint32_t key;
+    Index edge;
+  };
+  std::vector<std::vector<Queued>> phase_lists_;  // per part and region: the edges to queue
+  std::vector<std::uint32_t> phase_histograms_;   // per part: the costs' top bits
 
   std::size_t faces_ = 0;
   std::size_t target_ = 0;
@@ -548,70 +559,73 @@ void Decimator::compute_quadrics() {
       if (const Vertex v(static_cast<Index>(i)); !m_.is_deleted(v)) vd_[i].position = to_float(local(v));
     }
   });
-  // Each thread sums the planes at the vertices of its own index range, scanning every face
-  // and boundary edge in order: a vertex receives its planes in the same order, so the same
-  // bits, for any number of threads. A face with corners in two ranges is measured twice;
-  // in a mesh's usual vertex order few are.
+  // Each vertex sums the planes of its own faces and boundary edges, around its ring: the
+  // same order, so the same bits, on any number of threads.
   std::atomic<bool> has_boundary{false};
   parallel_for(n, opt_.threads, [&](std::size_t begin, std::size_t end) {
-    std::vector<Quadric> sum(end - begin);
-    auto mine = [&](Vertex v) { return v.idx() - begin < end - begin; };
-    add_face_planes(sum, begin, end, [&](Vertex v) { return at(v); });
-    for (Edge e : m_.edges()) {
-      Halfedge h = Mesh::halfedge(e, 0);
-      if (!m_.is_boundary(h)) h = Mesh::opposite(h);
-      if (!m_.is_boundary(h)) continue;
-      has_boundary.store(true, std::memory_order_relaxed);
-      const Halfedge inner = Mesh::opposite(h);
-      const Vertex a = m_.from_vertex(inner), b = m_.to_vertex(inner), c = m_.to_vertex(m_.next(inner));
-      if (!mine(a) && !mine(b)) continue;
-      const Vec3d pa = at(a), pb = at(b), pc = at(c);
-      const Vec3d along = pb - pa;
-      const Vec3d face_normal = cross(along, pc - pa);
-      Vec3d normal = cross(along, face_normal);
-      const double len = norm(normal);
-      if (!(len > 0)) continue;
-      normal /= len;
-      for (Vertex v : {a, b})
-        if (mine(v)) sum[v.idx() - begin].add_plane(normal, dot(normal, at(v) - pa), kBoundaryWeight * sqrnorm(along));
-    }
+    bool boundary = false;
     for (std::size_t i = begin; i < end; ++i) {
-      if (m_.is_deleted(Vertex(static_cast<Index>(i)))) continue;
+      const Vertex v(static_cast<Index>(i));
+      if (m_.is_deleted(v) || !m_.halfedge(v).is_valid()) continue;
+      Quadric q = face_planes(v, [&](Vertex w) { return at(w); });
+      boundary |= add_boundary_planes(v, q);
       // A weight scales every plane of the vertex, and so its share of a merged quadric: the
       // cost rises where detail matters while cost / weight stays a mean squared distance.
-      if (!weight_factor_.empty()) sum[i - begin] *= weight_factor_[i];
-      vd_[i].quadric.store(sum[i - begin]);
-    }
-    // Each shape's faces, as the mesh's own (its boundary is held by the mesh's quadrics).
-    for (std::size_t k = 0; k < shapes_.size(); ++k) {
-      std::fill(sum.begin(), sum.end(), Quadric());
-      add_face_planes(sum, begin, end, [&](Vertex v) { return shape_at(k, v); });
-      for (std::size_t i = begin; i < end; ++i) {
-        if (!weight_factor_.empty()) sum[i - begin] *= weight_factor_[i];
-        shape_quadrics_[i * shapes_.size() + k].store(sum[i - begin]);
+      if (!weight_factor_.empty()) q *= weight_factor_[i];
+      vd_[i].quadric.store(q);
+      // Each shape's faces, as the mesh's own (its boundary is held by the mesh's quadrics).
+      for (std::size_t k = 0; k < shapes_.size(); ++k) {
+        Quadric qk = face_planes(v, [&](Vertex w) { return shape_at(k, w); });
+        if (!weight_factor_.empty()) qk *= weight_factor_[i];
+        shape_quadrics_[i * shapes_.size() + k].store(qk);
       }
     }
+    if (boundary) has_boundary.store(true, std::memory_order_relaxed);
   });
   has_boundary_ = has_boundary.load();
 }
 
-// Face planes weighted by area, so that a region's error does not depend on how finely it
-// happens to be tessellated; each vertex's quadric is about its own place (where(v)).
+// The planes of v's faces weighted by area, so that a region's error does not depend on how
+// finely it happens to be tessellated, about v's own place (where(v)). Each face's plane
+// comes from its corners in its own order, the same bits for each of its vertices.
 template <class Where>
-void Decimator::add_face_planes(std::vector<Quadric>& sum, std::size_t begin, std::size_t end, Where where) const {
-  auto mine = [&](Vertex v) { return v.idx() - begin < end - begin; };
-  for (Face f : m_.faces()) {
+Quadric Decimator::face_planes(Vertex v, Where where) const {
+  Quadric q;
+  const Vec3d pv = where(v);
+  for (Halfedge x : m_.outgoing(v)) {
+    const Face f = m_.face(x);
+    if (!f.is_valid()) continue;
     const Halfedge h = m_.halfedge(f);
-    const Vertex a = m_.to_vertex(h), b = m_.to_vertex(m_.next(h)), c = m_.to_vertex(m_.prev(h));
-    if (!mine(a) && !mine(b) && !mine(c)) continue;
-    const Vec3d pa = where(a), pb = where(b), pc = where(c);
+    const Vec3d pa = where(m_.to_vertex(h)), pb = where(m_.to_vertex(m_.next(h))), pc = where(m_.to_vertex(m_.prev(h)));
     Vec3d normal = cross(pb - pa, pc - pa);
     const double len = norm(normal);
     if (!(len > 0)) continue;
     normal /= len;
-    for (Vertex v : {a, b, c})
-      if (mine(v)) sum[v.idx() - begin].add_plane(normal, dot(normal, where(v) - pa), 0.5 * len);
+    q.add_plane(normal, dot(normal, pv - pa), 0.5 * len);
   }
+  return q;
+}
+
+// The plane through each boundary edge at v, perpendicular to its face; true when there is one.
+bool Decimator::add_boundary_planes(Vertex v, Quadric& q) const {
+  bool any = false;
+  for (Halfedge x : m_.outgoing(v)) {
+    Halfedge h = x;
+    if (!m_.is_boundary(h)) h = Mesh::opposite(h);
+    if (!m_.is_boundary(h)) continue;
+    any = true;
+    const Halfedge inner = Mesh::opposite(h);
+    const Vertex a = m_.from_vertex(inner), b = m_.to_vertex(inner), c = m_.to_vertex(m_.next(inner));
+    const Vec3d pa = at(a), pb = at(b), pc = at(c);
+    const Vec3d along = pb - pa;
+    const Vec3d face_normal = cross(along, pc - pa);
+    Vec3d normal = cross(along, face_normal);
+    const double len = norm(normal);
+    if (!(len > 0)) continue;
+    normal /= len;
+    q.add_plane(normal, dot(normal, at(v) - pa), kBoundaryWeight * sqrnorm(along));
+  }
+  return any;
 }
 
 void Decimator::find_shapes() {
@@ -926,19 +940,18 @@ namespace {
 // counts as zero.
 std::uint32_t cost_bits(float cost) { return std::bit_cast<std::uint32_t>(std::max(cost, 0.0f)); }
 
-// A 15-bit Morton code of a point of the normalized frame (the bounding box centred on the
-// origin, its diagonal 1): 5 bits per axis, interleaved, of the grid moved by `offset`
+// The Morton code of a point of the normalized frame (the bounding box centred on the
+// origin, its diagonal 1): `bits` per axis, interleaved, of the grid moved by `offset`
 // (wrapping around).
-std::uint16_t morton_cell(const Vec3f& p, double offset) {
-  std::uint16_t code = 0;
+std::uint32_t morton_cell(const Vec3f& p, double offset, int bits) {
+  std::uint32_t code = 0;
   for (int axis = 0; axis < 3; ++axis) {
     const double x = double(p[axis]) + 0.5 + offset;
-    const int q = std::clamp(int((x - std::floor(x)) * 32), 0, 31);
-    for (int bit = 0; bit < 5; ++bit) code |= std::uint16_t(((q >> bit) & 1) << (3 * bit + axis));
+    const int q = std::clamp(int((x - std::floor(x)) * (1 << bits)), 0, (1 << bits) - 1);
+    for (int bit = 0; bit < bits; ++bit) code |= std::uint32_t((q >> bit) & 1) << (3 * bit + axis);
   }
   return code;
 }
-constexpr std::size_t kCells = std::size_t(1) << 15;
 }  // namespace
 
 void Decimator::collapse_in_regions() {
@@ -948,22 +961,27 @@ void Decimator::collapse_in_regions() {
   // Two orders of the vertices' Morton cells, on grids a third of the box apart, so that
   // the great planes of one order's octree, where regions always part, are not the other's:
   // each vertex's cell, and where each cell starts in its order.
-  std::vector<std::uint16_t> cells[2];
+  // Cells: 64 per axis up to 2 million vertices, 128 above.
+  const int bits = vertices <= (std::size_t(1) << 21) ? 6 : 7;
+  const std::size_t n_cells = std::size_t(1) << (3 * bits);
+  std::vector<std::uint32_t> cells[2];
   std::vector<std::size_t> cell_starts[2];
   for (int grid = 0; grid < 2; ++grid) {
-    std::vector<std::uint16_t>& cell = cells[grid];
+    std::vector<std::uint32_t>& cell = cells[grid];
     cell.resize(vertices);
     parallel_for(vertices, opt_.threads, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t i = begin; i < end; ++i) cell[i] = morton_cell(vd_[i].position, grid / 3.0);
+      for (std::size_t i = begin; i < end; ++i) cell[i] = morton_cell(vd_[i].position, grid / 3.0, bits);
     });
     std::vector<std::size_t>& cell_start = cell_starts[grid];
-    cell_start.assign(kCells + 1, 0);
+    cell_start.assign(n_cells + 1, 0);
     for (std::size_t i = 0; i < vertices; ++i) ++cell_start[cell[i] + 1];
-    for (std::size_t c = 0; c < kCells; ++c) cell_start[c + 1] += cell_start[c];
+    for (std::size_t c = 0; c < n_cells; ++c) cell_start[c + 1] += cell_start[c];
   }
   region_.resize(vertices);
   workers_.clear();
-  for (std::size_t r = 0; r < kRegions; ++r) workers_.emplace_back(&version_);
+  // Regions small enough to stay in cache, and no more than a region id can count.
+  regions_ = std::clamp<std::size_t>(vertices / kRegionVertices, kMinRegions, kNoRegion);
+  for (std::size_t r = 0; r < regions_; ++r) workers_.emplace_back(&version_);
 
   const std::size_t start_faces = faces_, to_remove = faces_ - target_;
   const std::size_t tail = std::max(kMinPhase, std::size_t(kTailShare * double(to_remove)));
@@ -974,60 +992,92 @@ void Decimator::collapse_in_regions() {
   }
   workers_.clear();
   region_ = {};
+  phase_lists_ = {};
+  phase_histograms_ = {};
 }
 
-std::size_t Decimator::collapse_phase(int phase, const std::vector<std::uint16_t>& cell,
+std::size_t Decimator::collapse_phase(int phase, const std::vector<std::uint32_t>& cell,
                                       const std::vector<std::size_t>& cell_start) {
   // 1. The regions: runs of cells of about equal numbers of vertices, shifted by half a run
   // every other phase of the same grid.
   const std::size_t vertices = cell.size();
-  const std::size_t shift = phase % 4 >= 2 ? vertices / (2 * kRegions) : 0;
-  std::vector<std::uint16_t> region_of_cell(kCells);
-  for (std::size_t c = 0; c < kCells; ++c)
-    region_of_cell[c] = std::uint16_t((cell_start[c] + shift) * kRegions / vertices % kRegions);
+  const std::size_t shift = phase % 4 >= 2 ? vertices / (2 * regions_) : 0;
+  const std::size_t n_cells = cell_start.size() - 1;
+  std::vector<std::uint16_t> region_of_cell(n_cells);
+  for (std::size_t c = 0; c < n_cells; ++c)
+    region_of_cell[c] = std::uint16_t((cell_start[c] + shift) * regions_ / vertices % regions_);
   parallel_for(vertices, opt_.threads, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) region_[i] = region_of_cell[cell[i]];
   });
 
-  // 2. The threshold: about a quarter of the faces still to remove, in collapses, cost less
-  // among the edges inside a region (each collapse removes two faces, and makes more cheap
-  // edges).
+  // 2. The threshold: a share of the faces still to remove, in collapses, cost less among
+  // the edges inside a region (each collapse removes two faces, and makes more cheap edges).
+  // Both passes over the edges run on all threads, each part a run of edges.
+  const std::size_t n_parts = resolve_thread_count(opt_.threads), n_edges = cost_.size();
+  auto for_each_part = [&](auto&& fn) {
+    parallel_for(
+        n_parts, opt_.threads,
+        [&](std::size_t begin, std::size_t end) {
+          for (std::size_t k = begin; k < end; ++k) fn(k, n_edges * k / n_parts, n_edges * (k + 1) / n_parts);
+        },
+        1);
+  };
+  auto region_of = [&](std::size_t i) -> std::uint16_t {
+    const Edge e(static_cast<Index>(i));
+    const std::uint16_t r = region_[m_.vertex(e, 0).idx()];
+    return r == region_[m_.vertex(e, 1).idx()] ? r : kNoRegion;
+  };
   constexpr int kShift = 16;
   constexpr std::size_t kBuckets = std::size_t(1) << (32 - kShift);
-  std::vector<std::uint32_t> histogram(kBuckets, 0);
-  auto inside = [&](std::size_t i) {
-    const Edge e(static_cast<Index>(i));
-    return region_[m_.vertex(e, 0).idx()] == region_[m_.vertex(e, 1).idx()];
-  };
-  for (std::size_t i = 0; i < cost_.size(); ++i)
-    if (cost_[i] != kNoCost && inside(i)) ++histogram[cost_bits(cost_[i]) >> kShift];
-  const std::size_t wanted = (faces_ - target_) / 4;
+  std::vector<std::uint32_t>& histograms = phase_histograms_;
+  histograms.assign(n_parts * kBuckets, 0);
+  for_each_part([&](std::size_t k, std::size_t begin, std::size_t end) {
+    std::uint32_t* histogram = histograms.data() + k * kBuckets;
+    for (std::size_t i = begin; i < end; ++i)
+      if (cost_[i] != kNoCost && region_of(i) != kNoRegion) ++histogram[cost_bits(cost_[i]) >> kShift];
+  });
+  const std::size_t wanted = (faces_ - target_) / kThresholdShare;
   std::size_t below = 0, last_bucket = 0;
   for (std::size_t b = 0; b < kBuckets && below < wanted; ++b) {
-    below += histogram[b];
-    if (histogram[b]) last_bucket = b;
+    std::size_t count = 0;
+    for (std::size_t k = 0; k < n_parts; ++k) count += histograms[k * kBuckets + b];
+    below += count;
+    if (count) last_bucket = b;
   }
   const float max_cost = std::bit_cast<float>(std::uint32_t(((last_bucket + 1) << kShift) - 1));
 
-  // 3. Each region's queue: its edges below the threshold with both ends inside it.
-  for (Worker& w : workers_) {
-    w.queue.clear();
-    w.region = std::uint16_t(&w - workers_.data());
-    w.max_cost = max_cost;
-    w.tally = {};
-    w.collapses = w.removed_faces = 0;
-    w.max_error_sq = 0;
-    w.refused_for_error = false;
-    w.remeasure.clear();
-  }
-  std::vector<std::size_t> candidates(kRegions, 0);
-  for (std::size_t i = 0; i < cost_.size(); ++i) {
-    if (cost_[i] == kNoCost || cost_[i] > max_cost || !inside(i)) continue;
-    const Edge e(static_cast<Index>(i));
-    const std::uint16_t r = region_[m_.vertex(e, 0).idx()];
-    workers_[r].queue.push(EdgeQueue::key(cost_[i], version_[i]), e.idx());
-    ++candidates[r];
-  }
+  // 3. Each region's queue: its edges below the threshold with both ends inside it, queued
+  // in edge order whatever the number of parts.
+  std::vector<std::vector<Queued>>& lists = phase_lists_;  // kept: their memory serves every phase
+  lists.resize(n_parts * regions_);
+  for (std::vector<Queued>& list : lists) list.clear();
+  for_each_part([&](std::size_t k, std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      if (cost_[i] == kNoCost || cost_[i] > max_cost) continue;
+      const std::uint16_t r = region_of(i);
+      if (r != kNoRegion) lists[k * regions_ + r].push_back({EdgeQueue::key(cost_[i], version_[i]), Index(i)});
+    }
+  });
+  std::vector<std::size_t> candidates(regions_, 0);
+  parallel_for(
+      regions_, opt_.threads,
+      [&](std::size_t begin, std::size_t end) {
+        for (std::size_t r = begin; r < end; ++r) {
+          Worker& w = workers_[r];
+          w.queue.clear();
+          w.region = std::uint16_t(r);
+          w.max_cost = max_cost;
+          w.tally = {};
+          w.collapses = w.removed_faces = 0;
+          w.max_error_sq = 0;
+          w.refused_for_error = false;
+          w.remeasure.clear();
+          for (std::size_t k = 0; k < n_parts; ++k)
+            for (const Queued& q : lists[k * regions_ + r]) w.queue.push(q.key, q.edge);
+          candidates[r] = w.queue.size();
+        }
+      },
+      1);
   // Each region may remove its share of the faces still to remove, by its candidates, so
   // that the regions together never pass the target.
   std::size_t total = 0;
@@ -1042,7 +1092,7 @@ std::size_t Decimator::collapse_phase(int phase, const std::vector<std::uint16_t
       resolve_thread_count(opt_.threads), opt_.threads,
       [&](std::size_t begin, std::size_t end) {
         for (std::size_t t = begin; t < end; ++t)
-          for (std::size_t r; (r = next.fetch_add(1)) < kRegions;) collapse_region(workers_[r]);
+          for (std::size_t r; (r = next.fetch_add(1)) < regions_;) collapse_region(workers_[r]);
       },
       1);
 
