@@ -1010,8 +1010,9 @@ std::size_t Decimator::collapse_phase(int phase, const std::vector<std::uint32_t
     for (std::size_t i = begin; i < end; ++i) region_[i] = region_of_cell[cell[i]];
   });
 
-  // 2. The threshold: a share of the faces still to remove, in collapses, cost less among
-  // the edges inside a region (each collapse removes two faces, and makes more cheap edges).
+  // 2. The threshold: a share of the faces still to remove, in collapses, cost less (each
+  // collapse removes two faces, and makes more cheap edges). Edges across borders count
+  // too: with the grids alternating few stay there, and the count reads only the costs.
   // Both passes over the edges run on all threads, each part a run of edges.
   const std::size_t n_parts = resolve_thread_count(opt_.threads), n_edges = cost_.size();
   auto for_each_part = [&](auto&& fn) {
@@ -1034,7 +1035,7 @@ std::size_t Decimator::collapse_phase(int phase, const std::vector<std::uint32_t
   for_each_part([&](std::size_t k, std::size_t begin, std::size_t end) {
     std::uint32_t* histogram = histograms.data() + k * kBuckets;
     for (std::size_t i = begin; i < end; ++i)
-      if (cost_[i] != kNoCost && region_of(i) != kNoRegion) ++histogram[cost_bits(cost_[i]) >> kShift];
+      if (cost_[i] != kNoCost) ++histogram[cost_bits(cost_[i]) >> kShift];
   });
   const std::size_t wanted = (faces_ - target_) / kThresholdShare;
   std::size_t below = 0, last_bucket = 0;
@@ -1179,13 +1180,35 @@ bool Decimator::triangle_ok(const Vec3d& old_apex, const Vec3d& new_apex, const 
 Decimator::Refusal Decimator::check(Halfedge h, const Point& target, Scratch& s, std::uint16_t region) const {
   const Halfedge o = Mesh::opposite(h);
   const Vertex v0 = m_.to_vertex(o), v1 = m_.to_vertex(h);
-  // First, during a phase: nothing outside the region may be read, another thread may be
-  // changing it. The faces around v0 and v1 hold only vertices of this region or of the
-  // border, which no region changes.
-  if (region != kNoRegion)
-    for (Vertex v : {v0, v1})
-      for (Halfedge x : m_.outgoing(v))
-        if (region_[m_.to_vertex(x).idx()] != region) return kRegion;
+
+  // The two rings, in order: each entry is a neighbour and the face between it and the next.
+  // Both rings are walked at once: each step waits for the half-edge the previous one
+  // named, so two walks side by side overlap their cache misses instead of queueing them.
+  // They come first: during a phase nothing outside the region may be read, another thread
+  // may be changing it (the faces around v0 and v1 hold only vertices of this region or of
+  // its border, which no region changes).
+  s.ring0.clear();
+  s.ring1.clear();
+  const Halfedge start0 = m_.halfedge(v0), start1 = m_.halfedge(v1);
+  Halfedge x0 = start0, x1 = start1;
+  bool more0 = true, more1 = true;  // neither end is isolated: both have h
+  bool outside = false;
+  auto step = [&](Halfedge& x, Halfedge start, bool& more, std::vector<RingEntry>& ring) {
+    const Vertex w = m_.to_vertex(x);
+    if (region != kNoRegion && region_[w.idx()] != region) outside = true;
+    // The fold test below reads every neighbour's position: start those cache misses now,
+    // so they overlap the link test instead of following it one by one.
+    detail::prefetch(&m_.position(w));
+    ring.push_back({w, m_.face(x), Vec3d{}});
+    x = m_.ccw_rotated(x);
+    more = x != start;
+  };
+  while ((more0 || more1) && !outside) {
+    if (more0) step(x0, start0, more0, s.ring0);
+    if (more1) step(x1, start1, more1, s.ring1);
+  }
+  if (outside) return kRegion;
+
   const Face fl = m_.face(h), fr = m_.face(o);
   Vertex vl, vr;
   if (fl.is_valid()) {
@@ -1211,27 +1234,6 @@ Decimator::Refusal Decimator::check(Halfedge h, const Point& target, Scratch& s,
   const int removed_faces = int(fl.is_valid()) + int(fr.is_valid());
   if (!b0 && !b1 && int(vd_[v0.idx()].valence) + int(vd_[v1.idx()].valence) - 2 - removed_faces < 3) return kLowValence;
 
-  // The two rings, in order: each entry is a neighbour and the face between it and the next.
-  // Both rings are walked at once: each step waits for the half-edge the previous one
-  // named, so two walks side by side overlap their cache misses instead of queueing them.
-  s.ring0.clear();
-  s.ring1.clear();
-  const Halfedge start0 = m_.halfedge(v0), start1 = m_.halfedge(v1);
-  Halfedge x0 = start0, x1 = start1;
-  bool more0 = true, more1 = true;  // neither end is isolated: both have h
-  auto step = [&](Halfedge& x, Halfedge start, bool& more, std::vector<RingEntry>& ring) {
-    const Vertex w = m_.to_vertex(x);
-    // The fold test below reads every neighbour's position: start those cache misses now,
-    // so they overlap the link test instead of following it one by one.
-    detail::prefetch(&m_.position(w));
-    ring.push_back({w, m_.face(x), Vec3d{}});
-    x = m_.ccw_rotated(x);
-    more = x != start;
-  };
-  while (more0 || more1) {
-    if (more0) step(x0, start0, more0, s.ring0);
-    if (more1) step(x1, start1, more1, s.ring1);
-  }
   // Link condition: the only common neighbours are vl and vr; and a second edge v0 - v1
   // would become a loop. The rings are short, so plain scans beat marking arrays.
   int edges_to_v1 = 0;
