@@ -17,6 +17,7 @@
 #include "bench.h"
 #include "hedge/error.h"
 #include "hedge/io.h"
+#include "hedge/threads.h"
 
 namespace bench {
 
@@ -259,7 +260,8 @@ void usage() {
       "  --op NAME      with --ops: only this operation in the in-process table (decimate, remesh,\n"
       "                 loop, catmull, sqrt3, smooth); repeatable\n"
       "  --scale        instead: the pipeline on the mesh Loop-subdivided to 10M+ triangles, and\n"
-      "                 build/decimate cost per triangle from 100k to 14M (--scale-growth: only that)\n");
+      "                 build/decimate cost per triangle from 100k to 14M (--scale-growth: only that)\n"
+      "  --threads N    threads hedge may use (default: all cores); the peers run on one\n");
   benchmark::PrintDefaultHelp();
 }
 
@@ -306,6 +308,10 @@ int main(int argc, char** argv) {
     }
     if (value("--op-reps", reps_text)) {
       op_reps = std::max(1, std::atoi(reps_text.c_str()));
+      continue;
+    }
+    if (value("--threads", reps_text)) {
+      hedge::set_thread_count(static_cast<unsigned>(std::max(0, std::atoi(reps_text.c_str()))));
       continue;
     }
     if (a == "--scale" || a == "--scale-growth") {

@@ -121,7 +121,7 @@ std::pair<double, double> time_decimate(const hedge::Soup& soup, int reps, std::
 }  // namespace
 
 int run_scale(const std::string& dragon_path, bool growth_only) {
-  std::printf("scale run: %s, %u threads (hedge::thread_count(); HEDGE_THREADS not read here)\n", dragon_path.c_str(),
+  std::printf("scale run: %s, %u threads (hedge::thread_count(): --threads, or all cores)\n", dragon_path.c_str(),
               hedge::thread_count());
   const hedge::Soup dragon = hedge::read_mesh(dragon_path);
   std::printf("input: %zu vertices, %zu faces\n\n", dragon.n_vertices(), dragon.n_faces());
