@@ -246,9 +246,9 @@ constexpr double kMaxWeightStrength = 1000;
 // 10% more mean error and no change in the Hausdorff distance on the dragon.
 constexpr double kPull = 0.01;
 
-// Collapsing in regions (Decimator::collapse_in_regions): from this many faces on, in this
-// many regions, while more than kTailShare of the faces to remove are left (and at least
-// kMinPhase collapses' worth).
+// Collapsing in regions (Decimator::collapse_in_regions): from this many faces on, while
+// more than kTailShare of the faces to remove are left (and at least kMinPhase collapses'
+// worth).
 constexpr std::size_t kRegionsMinFaces = 50000;
 constexpr std::size_t kRegionVertices = 16384;  // about this many vertices per region, in at least
 constexpr std::size_t kMinRegions = 32;         // this many regions
@@ -317,6 +317,11 @@ class Decimator {
     return true;
   }
   bool evaluate(Edge e, Candidate& c) const;
+  // The cost of e's best collapse; kNoCost when it has none (or is deleted).
+  float measure(Edge e) const {
+    Candidate c;
+    return !m_.is_deleted(e) && evaluate(e, c) ? c.cost : kNoCost;
+  }
   double boundary_shift(Halfedge h0, const Vec3d& p) const;
   struct Scratch;
   struct Worker;
@@ -363,9 +368,10 @@ class Decimator {
     Edge doomed[5];          // the collapsed edge and one of each merged pair
     int removed_faces;
   };
-  // The collapse itself: the mesh, the quadrics, attributes and flags. It reads and writes
-  // only the closed one-rings of h's ends, so collapses whose rings are apart may run on
-  // several threads at once, each with its own scratch and tally.
+  // The collapse itself: the mesh, the quadrics, attributes and flags. It writes only the
+  // vertices of the closed one-rings of h's ends and the faces around them, and reads only
+  // faces holding one of those vertices, so collapses in regions that hold their rings (a
+  // phase's) may run on several threads at once, each with its own scratch and tally.
   Collapsed apply_collapse(Halfedge h, const Candidate& c, Scratch& s, Mesh::Deletions& tally);
   // apply_collapse() and what follows in w's queue; returns the number of faces removed.
   int collapse(Halfedge h, const Candidate& c, Worker& w);
@@ -468,8 +474,9 @@ class Decimator {
   // own thread: a region collapses, greedily from its own queue, its edges below the phase's
   // cost threshold whose ends' one-rings lie wholly inside it, so regions never meet and the
   // result does not depend on which thread ran which region. Regions are runs of a Morton
-  // order of the vertices, fixed in number (not one per thread) and shifted by half a region
-  // every other phase, so that edges near one phase's borders are inside the next one's.
+  // order of the vertices, as many as the mesh's size asks (never one per thread); two grids
+  // alternate, each shifted by half a region every other time, so that edges near one
+  // phase's borders are inside the next one's.
   // Every region works on a small part of the mesh, which stays in cache better than the
   // one queue over everything. The queue over the whole mesh takes over for the last
   // collapses, which hit the exact target and relax the limits when needed.
@@ -909,9 +916,7 @@ void Decimator::measure_edges() {
       if (i + kAhead < end)
         for (unsigned side = 0; side < 2; ++side)
           detail::prefetch(&vd_[m_.vertex(Edge(static_cast<Index>(i + kAhead)), side).idx()]);
-      const Edge e(static_cast<Index>(i));
-      Candidate c;
-      cost_[i] = !m_.is_deleted(e) && evaluate(e, c) ? c.cost : kNoCost;
+      cost_[i] = measure(Edge(static_cast<Index>(i)));
     }
   });
 }
@@ -929,10 +934,9 @@ void Decimator::fill_heap() {
 
 void Decimator::requeue(Edge e, Worker& w) {
   const std::uint8_t v = ++version_[e.idx()];
-  Candidate c;
-  const bool found = evaluate(e, c);
-  if (!cost_.empty()) cost_[e.idx()] = found ? c.cost : kNoCost;
-  if (found && c.cost <= w.max_cost) w.queue.push(EdgeQueue::key(c.cost, v), e.idx());
+  const float cost = measure(e);
+  if (!cost_.empty()) cost_[e.idx()] = cost;
+  if (cost != kNoCost && cost <= w.max_cost) w.queue.push(EdgeQueue::key(cost, v), e.idx());
 }
 
 namespace {
@@ -981,7 +985,7 @@ void Decimator::collapse_in_regions() {
   workers_.clear();
   // Regions small enough to stay in cache, and no more than a region id can count.
   regions_ = std::clamp<std::size_t>(vertices / kRegionVertices, kMinRegions, kNoRegion);
-  for (std::size_t r = 0; r < regions_; ++r) workers_.emplace_back(&version_);
+  for (std::size_t r = 0; r < regions_; ++r) workers_.emplace_back(&version_).region = std::uint16_t(r);
 
   const std::size_t start_faces = faces_, to_remove = faces_ - target_;
   const std::size_t tail = std::max(kMinPhase, std::size_t(kTailShare * double(to_remove)));
@@ -1059,14 +1063,12 @@ std::size_t Decimator::collapse_phase(int phase, const std::vector<std::uint32_t
       if (r != kNoRegion) lists[k * regions_ + r].push_back({EdgeQueue::key(cost_[i], version_[i]), Index(i)});
     }
   });
-  std::vector<std::size_t> candidates(regions_, 0);
   parallel_for(
       regions_, opt_.threads,
       [&](std::size_t begin, std::size_t end) {
         for (std::size_t r = begin; r < end; ++r) {
           Worker& w = workers_[r];
           w.queue.clear();
-          w.region = std::uint16_t(r);
           w.max_cost = max_cost;
           w.tally = {};
           w.collapses = w.removed_faces = 0;
@@ -1075,22 +1077,21 @@ std::size_t Decimator::collapse_phase(int phase, const std::vector<std::uint32_t
           w.remeasure.clear();
           for (std::size_t k = 0; k < n_parts; ++k)
             for (const Queued& q : lists[k * regions_ + r]) w.queue.push(q.key, q.edge);
-          candidates[r] = w.queue.size();
         }
       },
       1);
   // Each region may remove its share of the faces still to remove, by its candidates, so
   // that the regions together never pass the target.
   std::size_t total = 0;
-  for (std::size_t n : candidates) total += n;
+  for (const Worker& w : workers_) total += w.queue.size();
   if (total == 0) return 0;
   for (Worker& w : workers_)
-    w.face_budget = std::size_t(double(faces_ - target_) * double(candidates[w.region]) / double(total));
+    w.face_budget = std::size_t(double(faces_ - target_) * double(w.queue.size()) / double(total));
 
   // 4. The regions, on all threads; each thread takes the next region left.
   std::atomic<std::size_t> next{0};
   parallel_for(
-      resolve_thread_count(opt_.threads), opt_.threads,
+      n_parts, opt_.threads,
       [&](std::size_t begin, std::size_t end) {
         for (std::size_t t = begin; t < end; ++t)
           for (std::size_t r; (r = next.fetch_add(1)) < regions_;) collapse_region(workers_[r]);
@@ -1106,10 +1107,7 @@ std::size_t Decimator::collapse_phase(int phase, const std::vector<std::uint32_t
     report_.collapses += w.collapses;
     max_error_sq_seen_ = std::max(max_error_sq_seen_, w.max_error_sq);
     refused_for_error_ = refused_for_error_ || w.refused_for_error;
-    for (Index i : w.remeasure) {
-      Candidate c;
-      cost_[i] = !m_.is_deleted(Edge(i)) && evaluate(Edge(i), c) ? c.cost : kNoCost;
-    }
+    for (Index i : w.remeasure) cost_[i] = measure(Edge(i));
   }
   return made;
 }
