@@ -482,12 +482,15 @@ class Decimator {
   // collapses, which hit the exact target and relax the limits when needed.
   void measure_edges();
   void collapse_in_regions();
-  std::size_t collapse_phase(int phase, const std::vector<std::uint32_t>& cell,
-                             const std::vector<std::size_t>& cell_start);
+  std::size_t collapse_phase();
   void collapse_region(Worker& w);
-  std::vector<float> cost_;            // per edge during the phases; kNoCost: no candidate
-  std::vector<std::uint16_t> region_;  // per vertex during a phase
-  std::vector<Worker> workers_;        // one per region
+  std::vector<float> cost_;  // per edge during the phases; kNoCost: no candidate
+  // Each vertex's region in the four partitions (two grids, each shifted or not), and the
+  // phase's partition.
+  std::vector<std::uint16_t> region_maps_[4];
+  const std::uint16_t* region_ = nullptr;
+  std::vector<Index> live_edges_;  // in order; those deleted are dropped at each phase
+  std::vector<Worker> workers_;    // one per region
   std::size_t regions_ = 0;
   struct Queued {
     std::uint32_t key;
@@ -962,64 +965,70 @@ void Decimator::collapse_in_regions() {
   m_.prepare_deletion_marks();
   version_.assign(m_.edges_size(), 0);
   const std::size_t vertices = m_.vertices_size();
-  // Two orders of the vertices' Morton cells, on grids a third of the box apart, so that
-  // the great planes of one order's octree, where regions always part, are not the other's:
-  // each vertex's cell, and where each cell starts in its order.
+  // Regions small enough to stay in cache, and no more than a region id can count.
+  regions_ = std::clamp<std::size_t>(vertices / kRegionVertices, kMinRegions, kNoRegion);
+  // The four partitions into regions: runs of about equal numbers of vertices along the
+  // Morton order of two grids a third of the box apart (so that the great planes of one
+  // grid's octree, where regions always part, are not the other's), each run shifted by
+  // half a run or not. The cells are of the vertices' places at the start: any partition
+  // serves, this one keeps regions compact.
   // Cells: 64 per axis up to 2 million vertices, 128 above.
   const int bits = vertices <= (std::size_t(1) << 21) ? 6 : 7;
   const std::size_t n_cells = std::size_t(1) << (3 * bits);
-  std::vector<std::uint32_t> cells[2];
-  std::vector<std::size_t> cell_starts[2];
+  std::vector<std::uint32_t> cell(vertices);
+  std::vector<std::size_t> cell_start(n_cells + 1);
+  std::vector<std::uint16_t> region_of_cell(n_cells);
   for (int grid = 0; grid < 2; ++grid) {
-    std::vector<std::uint32_t>& cell = cells[grid];
-    cell.resize(vertices);
     parallel_for(vertices, opt_.threads, [&](std::size_t begin, std::size_t end) {
       for (std::size_t i = begin; i < end; ++i) cell[i] = morton_cell(vd_[i].position, grid / 3.0, bits);
     });
-    std::vector<std::size_t>& cell_start = cell_starts[grid];
-    cell_start.assign(n_cells + 1, 0);
+    std::fill(cell_start.begin(), cell_start.end(), 0);
     for (std::size_t i = 0; i < vertices; ++i) ++cell_start[cell[i] + 1];
     for (std::size_t c = 0; c < n_cells; ++c) cell_start[c + 1] += cell_start[c];
+    for (int shifted = 0; shifted < 2; ++shifted) {
+      const std::size_t shift = shifted ? vertices / (2 * regions_) : 0;
+      for (std::size_t c = 0; c < n_cells; ++c)
+        region_of_cell[c] = std::uint16_t((cell_start[c] + shift) * regions_ / vertices % regions_);
+      std::vector<std::uint16_t>& map = region_maps_[2 * grid + shifted];
+      map.resize(vertices);
+      parallel_for(vertices, opt_.threads, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i) map[i] = region_of_cell[cell[i]];
+      });
+    }
   }
-  region_.resize(vertices);
+  cell = {};
+  live_edges_.resize(m_.edges_size());
+  for (std::size_t i = 0; i < live_edges_.size(); ++i) live_edges_[i] = Index(i);
   workers_.clear();
-  // Regions small enough to stay in cache, and no more than a region id can count.
-  regions_ = std::clamp<std::size_t>(vertices / kRegionVertices, kMinRegions, kNoRegion);
   for (std::size_t r = 0; r < regions_; ++r) workers_.emplace_back(&version_).region = std::uint16_t(r);
 
+  // The grids alternate, and each grid's runs shift every other time, so that edges near
+  // one phase's borders lie inside the next phase's regions.
   const std::size_t start_faces = faces_, to_remove = faces_ - target_;
   const std::size_t tail = std::max(kMinPhase, std::size_t(kTailShare * double(to_remove)));
   for (int phase = 0; faces_ - target_ > tail; ++phase) {
-    const std::size_t made = collapse_phase(phase, cells[phase % 2], cell_starts[phase % 2]);
+    region_ = region_maps_[2 * (phase % 2) + (phase % 4 >= 2)].data();
+    const std::size_t made = collapse_phase();
     progress_.update(0.1 + 0.85 * double(start_faces - faces_) / double(to_remove), "collapsing edges");
     if (made < kMinPhase) break;
   }
   workers_.clear();
-  region_ = {};
+  for (std::vector<std::uint16_t>& map : region_maps_) map = {};
+  region_ = nullptr;
+  live_edges_ = {};
   phase_lists_ = {};
   phase_histograms_ = {};
 }
 
-std::size_t Decimator::collapse_phase(int phase, const std::vector<std::uint32_t>& cell,
-                                      const std::vector<std::size_t>& cell_start) {
-  // 1. The regions: runs of cells of about equal numbers of vertices, shifted by half a run
-  // every other phase of the same grid.
-  const std::size_t vertices = cell.size();
-  const std::size_t shift = phase % 4 >= 2 ? vertices / (2 * regions_) : 0;
-  const std::size_t n_cells = cell_start.size() - 1;
-  std::vector<std::uint16_t> region_of_cell(n_cells);
-  for (std::size_t c = 0; c < n_cells; ++c)
-    region_of_cell[c] = std::uint16_t((cell_start[c] + shift) * regions_ / vertices % regions_);
-  parallel_for(vertices, opt_.threads, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i) region_[i] = region_of_cell[cell[i]];
-  });
-
-  // 2. The threshold: a share of the faces still to remove, in collapses, cost less (each
+std::size_t Decimator::collapse_phase() {
+  // 1. The threshold: a share of the faces still to remove, in collapses, cost less (each
   // collapse removes two faces, and makes more cheap edges). Edges across borders count
   // too: with the grids alternating few stay there, and the count reads only the costs.
   // Both passes over the edges run on all threads, each part a run of edges.
-  const std::size_t n_parts = resolve_thread_count(opt_.threads), n_edges = cost_.size();
+  // The edges deleted since the last phase leave the list of live edges on the way.
+  const std::size_t n_parts = resolve_thread_count(opt_.threads);
   auto for_each_part = [&](auto&& fn) {
+    const std::size_t n_edges = live_edges_.size();
     parallel_for(
         n_parts, opt_.threads,
         [&](std::size_t begin, std::size_t end) {
@@ -1036,11 +1045,28 @@ std::size_t Decimator::collapse_phase(int phase, const std::vector<std::uint32_t
   constexpr std::size_t kBuckets = std::size_t(1) << (32 - kShift);
   std::vector<std::uint32_t>& histograms = phase_histograms_;
   histograms.assign(n_parts * kBuckets, 0);
+  std::vector<std::size_t> part_live(n_parts + 1);
   for_each_part([&](std::size_t k, std::size_t begin, std::size_t end) {
     std::uint32_t* histogram = histograms.data() + k * kBuckets;
-    for (std::size_t i = begin; i < end; ++i)
+    std::size_t live = begin;
+    for (std::size_t j = begin; j < end; ++j) {
+      const Index i = live_edges_[j];
+      if (m_.is_deleted(Edge(i))) continue;
+      live_edges_[live++] = i;
       if (cost_[i] != kNoCost) ++histogram[cost_bits(cost_[i]) >> kShift];
+    }
+    part_live[k] = live - begin;
   });
+  {
+    std::size_t live = 0;
+    for (std::size_t k = 0; k < n_parts; ++k) {
+      const std::size_t begin = live_edges_.size() * k / n_parts;
+      std::copy_n(live_edges_.begin() + std::ptrdiff_t(begin), part_live[k],
+                  live_edges_.begin() + std::ptrdiff_t(live));
+      live += part_live[k];
+    }
+    live_edges_.resize(live);
+  }
   const std::size_t wanted = (faces_ - target_) / kThresholdShare;
   std::size_t below = 0, last_bucket = 0;
   for (std::size_t b = 0; b < kBuckets && below < wanted; ++b) {
@@ -1051,13 +1077,14 @@ std::size_t Decimator::collapse_phase(int phase, const std::vector<std::uint32_t
   }
   const float max_cost = std::bit_cast<float>(std::uint32_t(((last_bucket + 1) << kShift) - 1));
 
-  // 3. Each region's queue: its edges below the threshold with both ends inside it, queued
+  // 2. Each region's queue: its edges below the threshold with both ends inside it, queued
   // in edge order whatever the number of parts.
   std::vector<std::vector<Queued>>& lists = phase_lists_;  // kept: their memory serves every phase
   lists.resize(n_parts * regions_);
   for (std::vector<Queued>& list : lists) list.clear();
   for_each_part([&](std::size_t k, std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i) {
+    for (std::size_t j = begin; j < end; ++j) {
+      const Index i = live_edges_[j];
       if (cost_[i] == kNoCost || cost_[i] > max_cost) continue;
       const std::uint16_t r = region_of(i);
       if (r != kNoRegion) lists[k * regions_ + r].push_back({EdgeQueue::key(cost_[i], version_[i]), Index(i)});
@@ -1088,7 +1115,7 @@ std::size_t Decimator::collapse_phase(int phase, const std::vector<std::uint32_t
   for (Worker& w : workers_)
     w.face_budget = std::size_t(double(faces_ - target_) * double(w.queue.size()) / double(total));
 
-  // 4. The regions, on all threads; each thread takes the next region left.
+  // 3. The regions, on all threads; each thread takes the next region left.
   std::atomic<std::size_t> next{0};
   parallel_for(
       n_parts, opt_.threads,
@@ -1098,7 +1125,7 @@ std::size_t Decimator::collapse_phase(int phase, const std::vector<std::uint32_t
       },
       1);
 
-  // 5. Together again.
+  // 4. Together again.
   std::size_t made = 0;
   for (Worker& w : workers_) {
     m_.add_deletions(w.tally);
