@@ -99,11 +99,29 @@ const char* collapse_refusal(const Mesh& m, Halfedge h) {
 
   // Common neighbours other than vl and vr would become doubled edges; a second edge
   // between v0 and v1 (build() keeps those where the input has them) would become a loop.
+  // v1's ring is read once into a small array when it fits, rather than walked again for
+  // every neighbour of v0.
+  constexpr int kRingMax = 32;
+  Vertex ring1[kRingMax];
+  int n1 = 0;
+  for (Halfedge s : m.outgoing(v1)) {
+    if (n1 == kRingMax) {
+      n1 = -1;
+      break;
+    }
+    ring1[n1++] = m.to_vertex(s);
+  }
+  auto joined_to_v1 = [&](Vertex v) {
+    if (n1 < 0) return m.find_halfedge(v, v1).is_valid();
+    for (int i = 0; i < n1; ++i)
+      if (ring1[i] == v) return true;
+    return false;
+  };
   int edges_to_v1 = 0;
   for (Vertex v : m.vertices(v0)) {
     if (v == v1) {
       if (++edges_to_v1 > 1) return "a second edge joins its end vertices";
-    } else if (v != vl && v != vr && m.find_halfedge(v, v1).is_valid()) {
+    } else if (v != vl && v != vr && joined_to_v1(v)) {
       return "its end vertices have a common neighbour besides the triangles' corners (link condition)";
     }
   }
