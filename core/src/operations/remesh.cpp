@@ -16,6 +16,7 @@
 #include "hedge/error.h"
 #include "hedge/geometry.h"
 #include "hedge/provenance.h"
+#include "hedge/threads.h"
 #include "parallel.h"
 #include "selection.h"
 #include "welded_copies.h"
@@ -349,16 +350,42 @@ void Remesher::split_long_edges() {
   // the same far corner and multiplies slivers: a coarse mesh far above the target (a single
   // polygon of a few hundred corners) then grew to millions of triangles in the first pass.
   // Rounds refine evenly, about 4x per round, so the pass ends near area / L^2 triangles.
-  for (int round = 0; round < kMaxSplitRounds; ++round) {
+  // A split moves no vertex, so an edge that was short enough stays so: the first round
+  // measures every edge (on all threads), the next ones only the edges the last round made
+  // or left too long. Each round takes its edges in index order, as one sweep would.
+  auto too_long = [&](Index i) {
+    const Edge e(i);
+    if (mesh_.is_deleted(e) || (edge_flags_[i] & kFrozen)) return false;
+    const Vertex a = mesh_.vertex(e, 0), b = mesh_.vertex(e, 1);
+    const double hi = 4.0 / 3.0 * size(a, b);
+    return length_sq(a, b) > hi * hi;  // not with a NaN size
+  };
+  std::vector<Index> edges;
+  {
+    const std::size_t n = mesh_.edges_size();
+    const std::size_t parts = std::max<std::size_t>(1, std::min<std::size_t>(thread_count(), n / 16384));
+    std::vector<std::vector<Index>> found(parts);
+    hedge::parallel_for(
+        parts, 0,
+        [&](std::size_t begin, std::size_t end) {
+          for (std::size_t k = begin; k < end; ++k)
+            for (std::size_t i = n * k / parts; i < n * (k + 1) / parts; ++i)
+              if (too_long(Index(i))) found[k].push_back(Index(i));
+        },
+        1);
+    for (const std::vector<Index>& f : found) edges.insert(edges.end(), f.begin(), f.end());
+  }
+  std::vector<Index> again;
+  for (int round = 0; round < kMaxSplitRounds && !edges.empty(); ++round) {
     bool split = false;
     const Index n = static_cast<Index>(mesh_.edges_size());
-    for (Index i = 0; i < n; ++i) {
+    again.clear();
+    for (Index i : edges) {
+      if (!too_long(i)) continue;
+      again.push_back(i);  // split in two, or skipped: measured again next round
       const Edge e(i);
-      if (mesh_.is_deleted(e) || (edge_flags_[i] & kFrozen)) continue;
       Halfedge h0 = Mesh::halfedge(e, 0), h1 = Mesh::halfedge(e, 1);
       Vertex a = mesh_.to_vertex(h1), b = mesh_.to_vertex(h0);
-      double hi = 4.0 / 3.0 * size(a, b);
-      if (!(length_sq(a, b) > hi * hi)) continue;  // a NaN size too
       Vertex c = mesh_.is_boundary(h0) ? Vertex() : mesh_.to_vertex(mesh_.next(h0));
       Vertex d = mesh_.is_boundary(h1) ? Vertex() : mesh_.to_vertex(mesh_.next(h1));
       // Two triangles on the same third corner (a pillow, left by build() at non-manifold
@@ -390,6 +417,8 @@ void Remesher::split_long_edges() {
       split = true;
     }
     if (!split) break;
+    for (Index i = n; i < mesh_.edges_size(); ++i) again.push_back(i);
+    std::swap(edges, again);
   }
 }
 
@@ -525,7 +554,7 @@ void Remesher::collapse_short_edges() {
       if (!sizing_.empty()) sizing_[kept.idx()] = 0.5 * (sizing_[kept.idx()] + sizing_[gone.idx()]);
     }
 
-    mesh_.collapse(c);
+    mesh_.collapse_unchecked(c);  // may_collapse() has just run is_collapse_ok()
     if (midpoint) mesh_.position(kept) = to_float(mid);
     if (left.is_valid()) edge_flags_[left_kept.idx()] |= edge_flags_[left_gone.idx()];
     if (right.is_valid()) edge_flags_[right_kept.idx()] |= edge_flags_[right_gone.idx()];
