@@ -45,6 +45,10 @@ class TriangleTree {
   bool empty() const { return triangles_.empty(); }
   //! The mesh face a triangle came from (mesh constructor), else the triangle itself.
   Face face(Index triangle) const { return faces_.empty() ? Face(triangle) : faces_[triangle]; }
+  //! Where a triangle lies in the tree's own order, in which triangles near one another
+  //! in space mostly are near: queries taken in this order of their hints reuse the
+  //! branches the last one brought into cache.
+  Index tree_order(Index triangle) const { return position_[triangle]; }
   //! The triangle's corners, in the order given.
   std::array<Vec3d, 3> corners(Index triangle) const;
   //! Bounding box of all triangles.

@@ -9,6 +9,7 @@
 #include <numbers>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "binding.h"
@@ -140,11 +141,12 @@ class Remesher {
   std::vector<Degree> degree_;
   std::vector<Edge> work_;  // pending edges of the collapse and flip passes
   std::vector<Index> surface_hint_, curve_hint_;
-  std::vector<double> sizing_;                 // per vertex, adaptive only
-  std::vector<double> input_sizing_;           // per input vertex, adaptive only
-  std::vector<Point> scratch_;                 // smoothed positions
-  std::vector<PropertyArray*> vertex_arrays_;  // blended on splits (non-internal)
-  std::vector<PropertyArray*> corner_arrays_;  // continued on collapses (non-internal)
+  std::vector<double> sizing_;                    // per vertex, adaptive only
+  std::vector<double> input_sizing_;              // per input vertex, adaptive only
+  std::vector<Point> scratch_;                    // smoothed positions
+  std::vector<Index> move_order_, order_starts_;  // smooth_and_project()'s order of the vertices
+  std::vector<PropertyArray*> vertex_arrays_;     // blended on splits (non-internal)
+  std::vector<PropertyArray*> corner_arrays_;     // continued on collapses (non-internal)
 };
 
 std::array<Halfedge, 3> Remesher::input_corners(Index t) const {
@@ -687,12 +689,37 @@ void Remesher::smooth_and_project() {
   scratch_.resize(nv);
   const bool adaptive = !sizing_.empty();
 
+  // The vertices that move, in the surface tree's order of the triangles they were last
+  // projected onto (a counting sort by runs of 32): near ones come together, so each
+  // vertex mostly reads neighbours and tree branches the one before brought into cache
+  // (both the mesh and the tree are far larger than the cache).
+  std::vector<Index>& order = move_order_;
+  {
+    constexpr int kRun = 5;
+    std::vector<Index>& starts = order_starts_;
+    starts.assign((surface_.n_triangles() >> kRun) + 2, 0);
+    auto run_of = [&](std::size_t i) -> std::size_t {
+      const Index hint = surface_hint_[i];
+      return hint < surface_.n_triangles() ? (surface_.tree_order(hint) >> kRun) + 1 : 0;
+    };
+    auto moves = [&](std::size_t i) {
+      return !mesh_.is_deleted(Vertex(static_cast<Index>(i))) && kind_[i] != Kind::fixed;
+    };
+    for (std::size_t i = 0; i < nv; ++i)
+      if (moves(i)) ++starts[run_of(i)];
+    Index total = 0;
+    for (Index& s : starts) total += std::exchange(s, total);
+    order.resize(total);
+    for (std::size_t i = 0; i < nv; ++i)
+      if (moves(i)) order[starts[run_of(i)]++] = Index(i);
+  }
+
   for (int step = 0; step < kSmoothingSteps; ++step) {
     // Jacobi: every vertex reads the old positions, so the two halves run independently.
-    parallel_for(nv, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t i = begin; i < end; ++i) {
+    parallel_for(order.size(), [&](std::size_t begin, std::size_t end) {
+      for (std::size_t j = begin; j < end; ++j) {
+        const std::size_t i = order[j];
         const Vertex v(static_cast<Index>(i));
-        if (mesh_.is_deleted(v) || kind_[i] == Kind::fixed) continue;
         const Vec3d p = to_double(mesh_.position(v));
         Vec3d centroid{}, normal{};
         double weight = 0;
@@ -745,16 +772,14 @@ void Remesher::smooth_and_project() {
         }
       }
     });
-    for (std::size_t i = 0; i < nv; ++i)
-      if (kind_[i] != Kind::fixed && !mesh_.is_deleted(Vertex(static_cast<Index>(i))))
-        mesh_.position(Vertex(static_cast<Index>(i))) = scratch_[i];
+    for (Index i : order) mesh_.position(Vertex(i)) = scratch_[i];
   }
 
   // Back onto the input: free vertices onto the surface, sliding ones onto their curves.
-  parallel_for(nv, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i) {
+  parallel_for(order.size(), [&](std::size_t begin, std::size_t end) {
+    for (std::size_t j = begin; j < end; ++j) {
+      const std::size_t i = order[j];
       const Vertex v(static_cast<Index>(i));
-      if (mesh_.is_deleted(v) || kind_[i] == Kind::fixed) continue;
       const Vec3d p = to_double(mesh_.position(v));
       if (kind_[i] == Kind::free) {
         ClosestPoint c = surface_.closest_point_with_hint(p, surface_hint_[i]);
