@@ -6,6 +6,7 @@
 
 #include "hedge/error.h"
 #include "hedge/limits.h"
+#include "parallel.h"
 
 namespace hedge {
 
@@ -258,38 +259,82 @@ void Mesh::delete_vertex(Vertex v) {
 }
 
 namespace {
-// Old -> new index for live elements, new -> old for the gather; keeps relative order.
+// The live elements, in index order.
 template <class IsDeleted>
-void compaction_maps(std::size_t n, IsDeleted is_deleted, std::vector<Index>& old_to_new,
-                     std::vector<Index>& new_to_old) {
-  old_to_new.assign(n, kInvalidIndex);
-  new_to_old.clear();
+std::vector<Index> live_elements(std::size_t n, IsDeleted is_deleted) {
+  std::vector<Index> live;
+  live.reserve(n);
   for (std::size_t i = 0; i < n; ++i)
-    if (!is_deleted(static_cast<Index>(i))) {
-      old_to_new[i] = static_cast<Index>(new_to_old.size());
-      new_to_old.push_back(static_cast<Index>(i));
-    }
+    if (!is_deleted(static_cast<Index>(i))) live.push_back(static_cast<Index>(i));
+  return live;
 }
 
-template <class Array>
-void gather(Array& data, const std::vector<Index>& new_to_old) {
-  Array out;
-  out.reserve(new_to_old.size());
-  for (Index i : new_to_old) out.push_back(data[i]);
+// data[i] becomes data[new_to_old[i]], and each element x then f(x), on all threads.
+template <class Array, class F>
+void gather(Array& data, std::span<const Index> new_to_old, F f) {
+  Array out(new_to_old.size());
+  parallel_for(new_to_old.size(), 0, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) out[i] = f(data[new_to_old[i]]);
+  });
   data.swap(out);
 }
 }  // namespace
 
 GarbageMaps Mesh::garbage_collect() {
+  if (!has_garbage()) {
+    GarbageMaps maps;
+    auto identity = [](std::vector<Index>& map, std::size_t n) {
+      map.resize(n);
+      for (std::size_t i = 0; i < n; ++i) map[i] = static_cast<Index>(i);
+    };
+    identity(maps.vertices, vertices_size());
+    identity(maps.halfedges, halfedges_size());
+    identity(maps.edges, edges_size());
+    identity(maps.faces, faces_size());
+    return maps;
+  }
+  return renumber(live_elements(vertices_size(), [&](Index i) { return is_deleted(Vertex(i)); }),
+                  live_elements(edges_size(), [&](Index i) { return is_deleted(Edge(i)); }),
+                  live_elements(faces_size(), [&](Index i) { return is_deleted(Face(i)); }));
+}
+
+GarbageMaps Mesh::reorder(std::span<const Index> vertex_order, std::span<const Index> edge_order,
+                          std::span<const Index> face_order) {
+  // Each order must name every live element once, and nothing else.
+  auto check = [](std::span<const Index> order, std::size_t n, std::size_t live, auto is_deleted, const char* what) {
+    if (order.size() != live)
+      throw Error(std::string("reorder: the ") + what + " order lists " + std::to_string(order.size()) + " " + what +
+                  "; the mesh has " + std::to_string(live));
+    std::vector<std::uint8_t> seen(n, 0);
+    for (Index i : order) {
+      if (i >= n || is_deleted(i) || seen[i])
+        throw Error(std::string("reorder: the ") + what + " order names " + what + " " + std::to_string(i) + ", " +
+                    (i >= n    ? "which does not exist"
+                     : seen[i] ? "twice"
+                               : "which is deleted"));
+      seen[i] = 1;
+    }
+  };
+  check(
+      vertex_order, vertices_size(), n_vertices(), [&](Index i) { return is_deleted(Vertex(i)); }, "vertices");
+  check(
+      edge_order, edges_size(), n_edges(), [&](Index i) { return is_deleted(Edge(i)); }, "edges");
+  check(
+      face_order, faces_size(), n_faces(), [&](Index i) { return is_deleted(Face(i)); }, "faces");
+  return renumber(vertex_order, edge_order, face_order);
+}
+
+GarbageMaps Mesh::renumber(std::span<const Index> vkeep, std::span<const Index> ekeep, std::span<const Index> fkeep) {
   GarbageMaps maps;
-  std::vector<Index> vkeep, ekeep, hkeep, fkeep;
-  compaction_maps(
-      vertices_size(), [&](Index i) { return is_deleted(Vertex(i)); }, maps.vertices, vkeep);
-  compaction_maps(
-      edges_size(), [&](Index i) { return is_deleted(Edge(i)); }, maps.edges, ekeep);
-  compaction_maps(
-      faces_size(), [&](Index i) { return is_deleted(Face(i)); }, maps.faces, fkeep);
+  auto old_to_new = [](std::vector<Index>& map, std::size_t n, std::span<const Index> keep) {
+    map.assign(n, kInvalidIndex);
+    for (std::size_t i = 0; i < keep.size(); ++i) map[keep[i]] = static_cast<Index>(i);
+  };
+  old_to_new(maps.vertices, vertices_size(), vkeep);
+  old_to_new(maps.edges, edges_size(), ekeep);
+  old_to_new(maps.faces, faces_size(), fkeep);
   maps.halfedges.assign(halfedges_size(), kInvalidIndex);
+  std::vector<Index> hkeep;
   hkeep.reserve(2 * ekeep.size());
   for (Index e : ekeep) {
     maps.halfedges[2 * e] = static_cast<Index>(hkeep.size());
@@ -297,24 +342,21 @@ GarbageMaps Mesh::garbage_collect() {
     maps.halfedges[2 * e + 1] = static_cast<Index>(hkeep.size());
     hkeep.push_back(2 * e + 1);
   }
-  if (!has_garbage()) return maps;
 
   auto map_h = [&](Halfedge h) { return h.is_valid() ? Halfedge(maps.halfedges[h.idx()]) : h; };
   auto map_v = [&](Vertex v) { return v.is_valid() ? Vertex(maps.vertices[v.idx()]) : v; };
   auto map_f = [&](Face f) { return f.is_valid() ? Face(maps.faces[f.idx()]) : f; };
 
-  gather(vertex_halfedge_, vkeep);
-  gather(positions_, vkeep);
-  for (Halfedge& h : vertex_halfedge_) h = map_h(h);
-  gather(halfedges_, hkeep);
-  for (HalfedgeRecord& r : halfedges_) {
+  gather(vertex_halfedge_, vkeep, map_h);
+  gather(positions_, vkeep, [](const Point& p) { return p; });
+  gather(halfedges_, hkeep, [&](HalfedgeRecord r) {
     r.vertex = map_v(r.vertex);
     r.face = map_f(r.face);
     r.next = map_h(r.next);
     r.prev = map_h(r.prev);
-  }
-  gather(face_halfedge_, fkeep);
-  for (Halfedge& h : face_halfedge_) h = map_h(h);
+    return r;
+  });
+  gather(face_halfedge_, fkeep, map_h);
 
   vprops_.permute(vkeep);
   hprops_.permute(hkeep);

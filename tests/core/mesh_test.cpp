@@ -5,8 +5,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <map>
+#include <string>
 #include <vector>
 
+#include "hedge/error.h"
 #include "hedge/provenance.h"
 #include "hedge/topology.h"
 #include "hedge/validate.h"
@@ -219,6 +222,75 @@ TEST(Mesh, DeleteFaceAndGarbageCollect) {
   EXPECT_EQ(tag[Vertex(7)], 80);
   EXPECT_EQ(m.position(Vertex(0)), (Point{{1, 0, 0}}));
   EXPECT_EQ(topology_stats(m).boundary_loops, 1u);
+}
+
+TEST(Mesh, ReorderRenumbersLiveElementsAndCarriesEverything) {
+  Mesh m = quad_grid();
+  auto tag = m.add_vertex_property<int>("tag");
+  auto face_tag = m.add_face_property<int>("face tag");
+  for (Vertex v : m.vertices()) tag[v] = int(v.idx()) * 10;
+  for (Face f : m.faces()) face_tag[f] = int(f.idx()) + 100;
+  m.delete_face(Face(0));  // vertex 0 goes with it
+  auto reversed = [](auto range) {
+    std::vector<Index> order;
+    for (auto x : range) order.push_back(x.idx());
+    std::reverse(order.begin(), order.end());
+    return order;
+  };
+  const std::vector<Index> vo = reversed(m.vertices()), eo = reversed(m.edges()), fo = reversed(m.faces());
+  // Each face's corner positions, in order from corner 0, by its tag.
+  auto corners_by_tag = [&] {
+    std::map<int, std::vector<Point>> out;
+    for (Face f : m.faces())
+      for (Vertex v : m.vertices(f)) out[face_tag[f]].push_back(m.position(v));
+    return out;
+  };
+  const auto before = corners_by_tag();
+
+  const GarbageMaps maps = m.reorder(vo, eo, fo);
+  ASSERT_TRUE(validate(m)) << validate(m).message;
+  EXPECT_FALSE(m.has_garbage());
+  EXPECT_EQ(m.vertices_size(), 8u);
+  EXPECT_EQ(m.faces_size(), 3u);
+  EXPECT_EQ(maps.vertices[0], kInvalidIndex);
+  EXPECT_EQ(maps.vertices[8], 0u);  // the last vertex comes first
+  EXPECT_EQ(maps.faces[3], 0u);
+  EXPECT_EQ(tag[Vertex(0)], 80);  // properties moved with their elements
+  EXPECT_EQ(m.position(Vertex(0)), (Point{{2, 2, 0}}));
+  EXPECT_EQ(face_tag[Face(0)], 103);
+  EXPECT_EQ(corners_by_tag(), before);  // same faces, same corners, same order around
+  EXPECT_EQ(topology_stats(m).boundary_loops, 1u);
+}
+
+TEST(Mesh, ReorderRefusesAnOrderThatIsNotOneOfTheLiveElements) {
+  Mesh m = quad_grid();
+  m.delete_face(Face(0));
+  const Mesh before = m;
+  std::vector<Index> vo, eo, fo;
+  for (Vertex v : m.vertices()) vo.push_back(v.idx());
+  for (Edge e : m.edges()) eo.push_back(e.idx());
+  for (Face f : m.faces()) fo.push_back(f.idx());
+  auto refused = [&](std::vector<Index> v, std::vector<Index> e, std::vector<Index> f, const char* says) {
+    try {
+      m.reorder(v, e, f);
+      ADD_FAILURE() << "accepted an order that " << says;
+    } catch (const Error& error) {
+      EXPECT_NE(std::string(error.what()).find(says), std::string::npos) << error.what();
+    }
+    EXPECT_EQ(m.vertices_size(), before.vertices_size());
+    EXPECT_TRUE(m.has_garbage());  // nothing changed
+  };
+  std::vector<Index> twice = vo;
+  twice.back() = twice.front();
+  refused(twice, eo, fo, "twice");
+  std::vector<Index> dead = fo;
+  dead.front() = 0;  // the deleted face
+  refused(vo, eo, dead, "deleted");
+  std::vector<Index> short_list(eo.begin(), eo.end() - 1);
+  refused(vo, short_list, fo, "the mesh has");
+  std::vector<Index> beyond = vo;
+  beyond.back() = 99;
+  refused(beyond, eo, fo, "does not exist");
 }
 
 TEST(Mesh, DeleteVertexRemovesItsFaces) {

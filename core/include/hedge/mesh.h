@@ -348,6 +348,13 @@ class Mesh {
   void delete_vertex(Vertex v);
   //! Compacts the arrays, keeping the relative order of the live elements.
   GarbageMaps garbage_collect();
+  //! Renumbers the live elements: vertex_order[i] (an index now) becomes vertex i, and so
+  //! for edges and faces; each order lists every live element once. Deleted elements go, as
+  //! in garbage_collect(). For laying a mesh out in memory to suit an algorithm's walks
+  //! (detail::sort_spatially()). Throws Error, changing nothing, when an order is not such a
+  //! list.
+  GarbageMaps reorder(std::span<const Index> vertex_order, std::span<const Index> edge_order,
+                      std::span<const Index> face_order);
 
   // ---- Euler operations (euler.cpp); each keeps every invariant ------------------------
   //! A new isolated vertex.
@@ -454,6 +461,10 @@ class Mesh {
     if (auto* a = c.get<T>(name)) return Property<H, T>(a);
     return Property<H, T>(c.add<T>(name, def));
   }
+  // garbage_collect() and reorder(): element i of each array becomes element i of the order
+  // given (new -> old).
+  GarbageMaps renumber(std::span<const Index> vertex_order, std::span<const Index> edge_order,
+                       std::span<const Index> face_order);
   void mark_deleted(Vertex v, Deletions& tally);
   void mark_deleted(Edge e, Deletions& tally);
   void mark_deleted(Face f, Deletions& tally);

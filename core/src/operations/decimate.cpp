@@ -20,6 +20,7 @@
 #include "hedge/limits.h"
 #include "parallel.h"
 #include "selection.h"
+#include "spatial_order.h"
 #include "welded_copies.h"
 #ifdef HEDGE_DECIMATE_DEBUG
 #include <cstdio>
@@ -947,18 +948,6 @@ namespace {
 // counts as zero.
 std::uint32_t cost_bits(float cost) { return std::bit_cast<std::uint32_t>(std::max(cost, 0.0f)); }
 
-// The Morton code of a point of the normalized frame (the bounding box centred on the
-// origin, its diagonal 1): `bits` per axis, interleaved, of the grid moved by `offset`
-// (wrapping around).
-std::uint32_t morton_cell(const Vec3f& p, double offset, int bits) {
-  std::uint32_t code = 0;
-  for (int axis = 0; axis < 3; ++axis) {
-    const double x = double(p[axis]) + 0.5 + offset;
-    const int q = std::clamp(int((x - std::floor(x)) * (1 << bits)), 0, (1 << bits) - 1);
-    for (int bit = 0; bit < bits; ++bit) code |= std::uint32_t((q >> bit) & 1) << (3 * bit + axis);
-  }
-  return code;
-}
 }  // namespace
 
 void Decimator::collapse_in_regions() {
@@ -980,7 +969,7 @@ void Decimator::collapse_in_regions() {
   std::vector<std::uint16_t> region_of_cell(n_cells);
   for (int grid = 0; grid < 2; ++grid) {
     parallel_for(vertices, opt_.threads, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t i = begin; i < end; ++i) cell[i] = morton_cell(vd_[i].position, grid / 3.0, bits);
+      for (std::size_t i = begin; i < end; ++i) cell[i] = detail::morton_cell(vd_[i].position, grid / 3.0, bits);
     });
     std::fill(cell_start.begin(), cell_start.end(), 0);
     for (std::size_t i = 0; i < vertices; ++i) ++cell_start[cell[i] + 1];

@@ -20,6 +20,7 @@
 #include "hedge/threads.h"
 #include "parallel.h"
 #include "selection.h"
+#include "spatial_order.h"
 #include "welded_copies.h"
 
 namespace hedge {
@@ -975,12 +976,12 @@ RemeshReport remesh(Mesh& mesh, const RemeshOptions& options, Progress& progress
   // caller gets back when something fails or the user cancels.
   Mesh backup = mesh;
   try {
-    std::optional<Mesh> collected;
-    if (mesh.has_garbage()) {
-      mesh.garbage_collect();
-      collected = mesh;
-    }
-    Remesher remesher(mesh, collected ? *collected : backup, options, progress);
+    // Every pass walks the mesh in index order: numbered along a space-filling curve, it
+    // stays in cache far better (and deleted elements go). The surface to project onto is
+    // this copy, numbered as the working mesh is at the start.
+    detail::sort_spatially(mesh);
+    const Mesh input = mesh;
+    Remesher remesher(mesh, input, options, progress);
     return remesher.run();
   } catch (...) {
     mesh = std::move(backup);

@@ -1,0 +1,107 @@
+// detail::sort_spatially: the mesh renumbered along a Morton order (spatial_order.h).
+#include "spatial_order.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "parallel.h"
+
+namespace hedge::detail {
+
+namespace {
+// The low 10 bits of x, spread to every third bit.
+std::uint32_t spread_bits(std::uint32_t x) {
+  x &= 0x3ff;
+  x = (x | (x << 16)) & 0x030000ff;
+  x = (x | (x << 8)) & 0x0300f00f;
+  x = (x | (x << 4)) & 0x030c30c3;
+  x = (x | (x << 2)) & 0x09249249;
+  return x;
+}
+
+// Sorts `items` stably by key(item), a code of 3 * kBits bits: a radix sort, kBits a pass.
+template <class Key>
+void sort_by_code(std::vector<Index>& items, Key key) {
+  constexpr int kBits = 10;
+  std::vector<Index> scratch(items.size());
+  std::vector<std::size_t> start((std::size_t(1) << kBits) + 1);
+  for (int pass = 0; pass < 3; ++pass) {
+    const int shift = pass * kBits;
+    auto digit = [&](Index i) { return (key(i) >> shift) & ((1u << kBits) - 1); };
+    std::fill(start.begin(), start.end(), 0);
+    for (Index i : items) ++start[digit(i) + 1];
+    for (std::size_t b = 1; b < start.size(); ++b) start[b] += start[b - 1];
+    for (Index i : items) scratch[start[digit(i)]++] = i;
+    items.swap(scratch);
+  }
+}
+}  // namespace
+
+std::uint32_t morton_cell(const Vec3f& p, double offset, int bits) {
+  std::uint32_t code = 0;
+  for (int axis = 0; axis < 3; ++axis) {
+    double x = double(p[axis]) + 0.5 + offset;
+    x -= double(static_cast<long long>(x));  // wrapped into [0, 1) (towards zero, then up)
+    if (x < 0) x += 1;
+    const int q = std::clamp(int(x * (1 << bits)), 0, (1 << bits) - 1);
+    code |= spread_bits(std::uint32_t(q)) << axis;
+  }
+  return code;
+}
+
+GarbageMaps sort_spatially(Mesh& m, unsigned threads) {
+  // 1. The normalized frame: the bounding box of the live vertices, centred, diagonal 1.
+  constexpr float inf = std::numeric_limits<float>::infinity();
+  Vec3f lo{{inf, inf, inf}}, hi{{-inf, -inf, -inf}};
+  for (Vertex v : m.vertices())
+    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], m.position(v)[k]), hi[k] = std::max(hi[k], m.position(v)[k]);
+  const Vec3d center = (to_double(lo) + to_double(hi)) * 0.5;
+  double scale = distance(to_double(lo), to_double(hi));
+  if (!(scale > 0) || !std::isfinite(scale)) scale = 1;
+
+  // 2. The cells (10 bits per axis) of the live vertices and of the faces' centroids, on
+  // all threads; both sorted by cell.
+  constexpr int kBits = 10;
+  auto cell = [&](const Vec3d& p) { return morton_cell(to_float((p - center) / scale), 0, kBits); };
+  std::vector<std::uint32_t> vertex_cell(m.vertices_size()), face_cell(m.faces_size());
+  parallel_for(m.vertices_size(), threads, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i)
+      if (!m.is_deleted(Vertex(static_cast<Index>(i)))) vertex_cell[i] = cell(to_double(m.position(Vertex(Index(i)))));
+  });
+  parallel_for(m.faces_size(), threads, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      const Face f(static_cast<Index>(i));
+      if (m.is_deleted(f)) continue;
+      Vec3d sum{};
+      int n = 0;
+      for (Vertex v : m.vertices(f)) sum += to_double(m.position(v)), ++n;
+      face_cell[i] = cell(sum / double(n));
+    }
+  });
+  std::vector<Index> vertices, faces, edges;
+  vertices.reserve(m.n_vertices());
+  for (Vertex v : m.vertices()) vertices.push_back(v.idx());
+  sort_by_code(vertices, [&](Index i) { return vertex_cell[i]; });
+  faces.reserve(m.n_faces());
+  for (Face f : m.faces()) faces.push_back(f.idx());
+  sort_by_code(faces, [&](Index i) { return face_cell[i]; });
+
+  // 3. Edges by the place of their first end in the new vertex order (a counting sort).
+  std::vector<Index> place(m.vertices_size());
+  for (std::size_t i = 0; i < vertices.size(); ++i) place[vertices[i]] = static_cast<Index>(i);
+  std::vector<Index> first_end(m.edges_size());
+  std::vector<std::size_t> start(vertices.size() + 1, 0);
+  for (Edge e : m.edges()) {
+    first_end[e.idx()] = std::min(place[m.vertex(e, 0).idx()], place[m.vertex(e, 1).idx()]);
+    ++start[first_end[e.idx()] + 1];
+  }
+  for (std::size_t b = 1; b < start.size(); ++b) start[b] += start[b - 1];
+  edges.resize(m.n_edges());
+  for (Edge e : m.edges()) edges[start[first_end[e.idx()]]++] = e.idx();
+
+  return m.reorder(vertices, edges, faces);
+}
+
+}  // namespace hedge::detail
