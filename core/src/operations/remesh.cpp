@@ -101,6 +101,7 @@ class Remesher {
   void split_long_edges();
   void collapse_short_edges();
   void equalize_valences();
+  bool is_cap(Edge e) const;  // an angle at e's opposite corners near 180 degrees
   bool open_cap(Edge e);
   void open_caps();
   void smooth_and_project();
@@ -637,20 +638,26 @@ void Remesher::equalize_valences() {
 // The last smoothing and projection can leave caps: a vertex pushed onto (or near) the
 // edge opposite it, an angle near 180 degrees. Flipping that edge, where the surface allows
 // it, opens them: the flip must raise the smallest angle of the two triangles.
+bool Remesher::is_cap(Edge e) const {
+  if (mesh_.is_deleted(e) || (edge_flags_[e.idx()] & kFeature) || mesh_.is_boundary(e)) return false;
+  const Halfedge h0 = Mesh::halfedge(e, 0), h1 = Mesh::halfedge(e, 1);
+  const Vec3d pa = to_double(mesh_.position(mesh_.to_vertex(h0))), pb = to_double(mesh_.position(mesh_.to_vertex(h1)));
+  constexpr double kCapCos = -0.8660254037844386;  // cos 150 degrees
+  auto cap_at = [&](Halfedge h) {
+    const Vec3d apex = to_double(mesh_.position(mesh_.to_vertex(mesh_.next(h))));
+    const double l = norm(pa - apex) * norm(pb - apex);
+    return (l > 0 ? dot(pa - apex, pb - apex) / l : -1.0) < kCapCos;
+  };
+  return cap_at(h0) || cap_at(h1);
+}
+
 bool Remesher::open_cap(Edge e) {
-  const Index i = e.idx();
-  if (mesh_.is_deleted(e) || (edge_flags_[i] & kFeature) || mesh_.is_boundary(e)) return false;
+  if (!is_cap(e)) return false;
   Halfedge h0 = Mesh::halfedge(e, 0), h1 = Mesh::halfedge(e, 1);
   Vertex a = mesh_.to_vertex(h0), b = mesh_.to_vertex(h1);
   Vertex c = mesh_.to_vertex(mesh_.next(h0)), d = mesh_.to_vertex(mesh_.next(h1));
   Vec3d pa = to_double(mesh_.position(a)), pb = to_double(mesh_.position(b));
   Vec3d pc = to_double(mesh_.position(c)), pd = to_double(mesh_.position(d));
-  constexpr double kCapCos = -0.8660254037844386;  // cos 150 degrees
-  auto cos_at = [](const Vec3d& apex, const Vec3d& p, const Vec3d& q) {
-    const double l = norm(p - apex) * norm(q - apex);
-    return l > 0 ? dot(p - apex, q - apex) / l : -1.0;
-  };
-  if (!(cos_at(pc, pa, pb) < kCapCos || cos_at(pd, pa, pb) < kCapCos)) return false;
   Vec3d old_normal = cross(pa - pb, pc - pb) + cross(pb - pa, pd - pa);
   Vec3d n1 = cross(pc - pa, pd - pa), n2 = cross(pb - pc, pd - pc);
   if (!(dot(n1, n2) > 0 && dot(n1, old_normal) > 0 && dot(n2, old_normal) > 0)) return false;
@@ -664,19 +671,26 @@ bool Remesher::open_cap(Edge e) {
 }
 
 void Remesher::open_caps() {
+  // A flip moves no vertex and changes the triangles of its own quad's edges only, which it
+  // puts on `pending`: the sweep needs to visit only the caps there are at the start (found
+  // on all threads) and the edges put on `pending` since.
+  const std::size_t n = mesh_.edges_size();
+  std::vector<std::uint8_t> visit(n);
+  parallel_for(n, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) visit[i] = is_cap(Edge(static_cast<Index>(i)));
+  });
   std::vector<Edge>& pending = work_;
   pending.clear();
   auto push_quad = [&](Edge e) {
     for (unsigned side = 0; side < 2; ++side) {
       Halfedge h = Mesh::halfedge(e, side);
-      pending.push_back(Mesh::edge(mesh_.next(h)));
-      pending.push_back(Mesh::edge(mesh_.prev(h)));
+      for (Edge x : {Mesh::edge(mesh_.next(h)), Mesh::edge(mesh_.prev(h))}) pending.push_back(x), visit[x.idx()] = 1;
     }
   };
   // Every flip raises the smallest angle of its pair; the budget only guards the loop.
-  std::size_t budget = mesh_.edges_size();
-  for (Index i = 0; i < mesh_.edges_size() && budget; ++i) {
-    if (open_cap(Edge(i))) push_quad(Edge(i)), --budget;
+  std::size_t budget = n;
+  for (Index i = 0; i < n && budget; ++i) {
+    if (visit[i] && open_cap(Edge(i))) push_quad(Edge(i)), --budget;
     while (!pending.empty() && budget) {
       Edge e = pending.back();
       pending.pop_back();
