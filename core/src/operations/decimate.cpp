@@ -1034,7 +1034,7 @@ std::size_t Decimator::collapse_phase() {
   constexpr std::size_t kBuckets = std::size_t(1) << (32 - kShift);
   std::vector<std::uint32_t>& histograms = phase_histograms_;
   histograms.assign(n_parts * kBuckets, 0);
-  std::vector<std::size_t> part_live(n_parts + 1);
+  std::vector<std::size_t> part_live(n_parts);
   for_each_part([&](std::size_t k, std::size_t begin, std::size_t end) {
     std::uint32_t* histogram = histograms.data() + k * kBuckets;
     std::size_t live = begin;
