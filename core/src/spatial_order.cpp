@@ -51,15 +51,21 @@ std::uint32_t morton_cell(const Vec3f& p, double offset, int bits) {
   return code;
 }
 
+Frame normalized_frame(const Mesh& m) {
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  Vec3d lo{{inf, inf, inf}}, hi{{-inf, -inf, -inf}};
+  for (Vertex v : m.vertices()) {
+    const Vec3d p = to_double(m.position(v));
+    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
+  }
+  Frame frame{(lo + hi) * 0.5, distance(lo, hi)};
+  if (!(frame.scale > 0) || !std::isfinite(frame.scale)) frame.scale = 1;
+  return frame;
+}
+
 GarbageMaps sort_spatially(Mesh& m, unsigned threads) {
-  // 1. The normalized frame: the bounding box of the live vertices, centred, diagonal 1.
-  constexpr float inf = std::numeric_limits<float>::infinity();
-  Vec3f lo{{inf, inf, inf}}, hi{{-inf, -inf, -inf}};
-  for (Vertex v : m.vertices())
-    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], m.position(v)[k]), hi[k] = std::max(hi[k], m.position(v)[k]);
-  const Vec3d center = (to_double(lo) + to_double(hi)) * 0.5;
-  double scale = distance(to_double(lo), to_double(hi));
-  if (!(scale > 0) || !std::isfinite(scale)) scale = 1;
+  // 1. The normalized frame.
+  const auto [center, scale] = normalized_frame(m);
 
   // 2. The cells (10 bits per axis) of the live vertices and of the faces' centroids, on
   // all threads; both sorted by cell.

@@ -524,15 +524,9 @@ void Decimator::triangulate_polygons() {
 // Quadrics are built in coordinates centred on the bounding box and scaled by its diagonal:
 // errors come out as fractions of the diagonal and keep their precision far from the origin.
 void Decimator::compute_frame() {
-  constexpr double inf = std::numeric_limits<double>::infinity();
-  Vec3d lo{{inf, inf, inf}}, hi{{-inf, -inf, -inf}};
-  for (Vertex v : m_.vertices()) {
-    const Vec3d p = to_double(m_.position(v));
-    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
-  }
-  center_ = (lo + hi) * 0.5;
-  scale_ = distance(lo, hi);
-  if (!(scale_ > 0) || !std::isfinite(scale_)) scale_ = 1;
+  const detail::Frame frame = detail::normalized_frame(m_);
+  center_ = frame.center;
+  scale_ = frame.scale;
   inv_scale_ = 1 / scale_;
 }
 
