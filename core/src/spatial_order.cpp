@@ -65,12 +65,12 @@ Frame normalized_frame(const Mesh& m) {
 
 GarbageMaps sort_spatially(Mesh& m, unsigned threads) {
   // 1. The normalized frame.
-  const auto [center, scale] = normalized_frame(m);
+  const Frame frame = normalized_frame(m);
 
   // 2. The cells (10 bits per axis) of the live vertices and of the faces' centroids, on
   // all threads; both sorted by cell.
   constexpr int kBits = 10;
-  auto cell = [&](const Vec3d& p) { return morton_cell(to_float((p - center) / scale), 0, kBits); };
+  auto cell = [&](const Vec3d& p) { return morton_cell(to_float((p - frame.center) / frame.scale), 0, kBits); };
   std::vector<std::uint32_t> vertex_cell(m.vertices_size()), face_cell(m.faces_size());
   parallel_for(m.vertices_size(), threads, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i)
