@@ -110,4 +110,39 @@ GarbageMaps sort_spatially(Mesh& m, unsigned threads) {
   return m.reorder(vertices, edges, faces);
 }
 
+RegionPartitions::RegionPartitions(std::size_t n, std::size_t regions, const std::function<Vec3f(std::size_t)>& place,
+                                   unsigned threads)
+    : regions_(std::clamp<std::size_t>(regions, 1, kNone - 1)) {
+  if (n == 0) return;
+  // Cells: 64 per axis up to 2 million vertices, 128 above.
+  const int bits = n <= (std::size_t(1) << 21) ? 6 : 7;
+  const std::size_t n_cells = std::size_t(1) << (3 * bits);
+  std::vector<std::uint32_t> cell(n);
+  std::vector<std::size_t> cell_start(n_cells + 1);
+  std::vector<std::uint16_t> region_of_cell(n_cells);
+  for (int grid = 0; grid < 2; ++grid) {
+    parallel_for(n, threads, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) cell[i] = morton_cell(place(i), grid / 3.0, bits);
+    });
+    std::fill(cell_start.begin(), cell_start.end(), 0);
+    for (std::size_t i = 0; i < n; ++i) ++cell_start[cell[i] + 1];
+    for (std::size_t c = 0; c < n_cells; ++c) cell_start[c + 1] += cell_start[c];
+    for (int shifted = 0; shifted < 2; ++shifted) {
+      const std::size_t shift = shifted ? n / (2 * regions_) : 0;
+      // Only the cells that hold vertices need a region (few do: the vertices lie on a
+      // surface). The quotient is exact in double precision: its numerator is below 2^53.
+      for (std::size_t c = 0; c < n_cells; ++c) {
+        if (cell_start[c] == cell_start[c + 1]) continue;
+        std::size_t r = std::size_t(double((cell_start[c] + shift) * regions_) / double(n));
+        region_of_cell[c] = std::uint16_t(r >= regions_ ? r - regions_ : r);
+      }
+      std::vector<std::uint16_t>& map = maps_[2 * grid + shifted];
+      map.resize(n);
+      parallel_for(n, threads, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i) map[i] = region_of_cell[cell[i]];
+      });
+    }
+  }
+}
+
 }  // namespace hedge::detail

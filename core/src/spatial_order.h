@@ -6,6 +6,8 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
+#include <vector>
 
 #include "hedge/mesh.h"
 
@@ -30,5 +32,37 @@ std::uint32_t morton_cell(const Vec3f& p, double offset, int bits);
 //! garbage_collect(). Geometry, attributes and connectivity are unchanged; only the
 //! numbering is.
 GarbageMaps sort_spatially(Mesh& m, unsigned threads = 0);
+
+//! Four partitions of n vertices into regions, for work done region by region on several
+//! threads in phases (decimation's and remeshing's collapses): regions are runs of about
+//! equal numbers of vertices along the Morton order of two grids a third of the box apart
+//! (so that the great planes of one grid's octree, where regions always part, are not the
+//! other's), each run shifted by half a run or not. Phases take them in turn (phase(k)), so
+//! that what lay on one phase's borders lies inside the next phase's regions.
+class RegionPartitions {
+ public:
+  static constexpr std::uint16_t kNone = 0xffff;  //!< no region: never a vertex's
+
+  RegionPartitions() = default;
+  //! `place(i)`: vertex i's place in the normalized frame (any place for a deleted one).
+  //! `regions` is clamped to [1, kNone - 1].
+  RegionPartitions(std::size_t n, std::size_t regions, const std::function<Vec3f(std::size_t)>& place,
+                   unsigned threads);
+
+  std::size_t regions() const { return regions_; }
+  //! How many vertices the partitions cover.
+  std::size_t size() const { return maps_[0].size(); }
+  //! Covers one more vertex (vertex size()), putting it in vertex `like`'s regions: a vertex
+  //! added to a mesh in the middle of an edge goes where one of its ends is.
+  void append_like(std::size_t like) {
+    for (std::vector<std::uint16_t>& map : maps_) map.push_back(map[like]);
+  }
+  //! Phase k's map from a vertex to its region.
+  const std::uint16_t* phase(int k) const { return maps_[2 * (k % 2) + (k % 4 >= 2)].data(); }
+
+ private:
+  std::size_t regions_ = 0;
+  std::vector<std::uint16_t> maps_[4];
+};
 
 }  // namespace hedge::detail

@@ -257,7 +257,7 @@ constexpr double kTailShare = 0.02;
 constexpr std::size_t kMinPhase = 2048;
 constexpr std::size_t kThresholdShare = 4;  // the threshold: (faces to remove) / this cost less
 constexpr float kNoCost = std::numeric_limits<float>::infinity();
-constexpr std::uint16_t kNoRegion = 0xffff;
+constexpr std::uint16_t kNoRegion = detail::RegionPartitions::kNone;
 
 class Decimator {
  public:
@@ -486,9 +486,8 @@ class Decimator {
   std::size_t collapse_phase();
   void collapse_region(Worker& w);
   std::vector<float> cost_;  // per edge during the phases; kNoCost: no candidate
-  // Each vertex's region in the four partitions (two grids, each shifted or not), and the
-  // phase's partition.
-  std::vector<std::uint16_t> region_maps_[4];
+  // The partitions into regions, and the phase's map from a vertex to its region.
+  detail::RegionPartitions partitions_;
   const std::uint16_t* region_ = nullptr;
   std::vector<Index> live_edges_;  // in order; those deleted are dropped at each phase
   std::vector<Worker> workers_;    // one per region
@@ -948,38 +947,12 @@ void Decimator::collapse_in_regions() {
   m_.prepare_deletion_marks();
   version_.assign(m_.edges_size(), 0);
   const std::size_t vertices = m_.vertices_size();
-  // Regions small enough to stay in cache, and no more than a region id can count.
-  regions_ = std::clamp<std::size_t>(vertices / kRegionVertices, kMinRegions, kNoRegion);
-  // The four partitions into regions: runs of about equal numbers of vertices along the
-  // Morton order of two grids a third of the box apart (so that the great planes of one
-  // grid's octree, where regions always part, are not the other's), each run shifted by
-  // half a run or not. The cells are of the vertices' places at the start: any partition
-  // serves, this one keeps regions compact.
-  // Cells: 64 per axis up to 2 million vertices, 128 above.
-  const int bits = vertices <= (std::size_t(1) << 21) ? 6 : 7;
-  const std::size_t n_cells = std::size_t(1) << (3 * bits);
-  std::vector<std::uint32_t> cell(vertices);
-  std::vector<std::size_t> cell_start(n_cells + 1);
-  std::vector<std::uint16_t> region_of_cell(n_cells);
-  for (int grid = 0; grid < 2; ++grid) {
-    parallel_for(vertices, opt_.threads, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t i = begin; i < end; ++i) cell[i] = detail::morton_cell(vd_[i].position, grid / 3.0, bits);
-    });
-    std::fill(cell_start.begin(), cell_start.end(), 0);
-    for (std::size_t i = 0; i < vertices; ++i) ++cell_start[cell[i] + 1];
-    for (std::size_t c = 0; c < n_cells; ++c) cell_start[c + 1] += cell_start[c];
-    for (int shifted = 0; shifted < 2; ++shifted) {
-      const std::size_t shift = shifted ? vertices / (2 * regions_) : 0;
-      for (std::size_t c = 0; c < n_cells; ++c)
-        region_of_cell[c] = std::uint16_t((cell_start[c] + shift) * regions_ / vertices % regions_);
-      std::vector<std::uint16_t>& map = region_maps_[2 * grid + shifted];
-      map.resize(vertices);
-      parallel_for(vertices, opt_.threads, [&](std::size_t begin, std::size_t end) {
-        for (std::size_t i = begin; i < end; ++i) map[i] = region_of_cell[cell[i]];
-      });
-    }
-  }
-  cell = {};
+  // Regions small enough to stay in cache. The cells are of the vertices' places at the
+  // start: any partition serves, this one keeps regions compact.
+  partitions_ = detail::RegionPartitions(
+      vertices, std::max(vertices / kRegionVertices, kMinRegions), [&](std::size_t i) { return vd_[i].position; },
+      opt_.threads);
+  regions_ = partitions_.regions();
   live_edges_.resize(m_.edges_size());
   for (std::size_t i = 0; i < live_edges_.size(); ++i) live_edges_[i] = Index(i);
   workers_.clear();
@@ -990,13 +963,13 @@ void Decimator::collapse_in_regions() {
   const std::size_t start_faces = faces_, to_remove = faces_ - target_;
   const std::size_t tail = std::max(kMinPhase, std::size_t(kTailShare * double(to_remove)));
   for (int phase = 0; faces_ - target_ > tail; ++phase) {
-    region_ = region_maps_[2 * (phase % 2) + (phase % 4 >= 2)].data();
+    region_ = partitions_.phase(phase);
     const std::size_t made = collapse_phase();
     progress_.update(0.1 + 0.85 * double(start_faces - faces_) / double(to_remove), "collapsing edges");
     if (made < kMinPhase) break;
   }
   workers_.clear();
-  for (std::vector<std::uint16_t>& map : region_maps_) map = {};
+  partitions_ = {};
   region_ = nullptr;
   live_edges_ = {};
   phase_lists_ = {};
