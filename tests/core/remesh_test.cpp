@@ -12,11 +12,13 @@
 #include <filesystem>
 #include <numbers>
 
+#include "defect_counts.h"
 #include "hedge/build.h"
 #include "hedge/catalogue.h"
 #include "hedge/distance.h"
 #include "hedge/io.h"
 #include "hedge/report.h"
+#include "hedge/threads.h"
 #include "hedge/validate.h"
 #include "test_meshes.h"
 
@@ -375,6 +377,51 @@ TEST(Remesh, IsDeterministic) {
     for (Vertex v : a.vertices(f)) va.push_back(v);
     for (Vertex v : b.vertices(f)) vb.push_back(v);
     ASSERT_EQ(va, vb);
+  }
+}
+
+// From 50,000 faces on, the collapses and flips run region by region on all threads. A
+// fine sphere with a fin along part of its equator (edges of three faces, which build()
+// splits into copies the weld joins again): the result is the same on one thread and on
+// two, and it has no defect the input had not.
+TEST(Remesh, RegionsGiveOneResultAtEveryThreadCount) {
+  const int rings = 130, segments = 240;
+  Soup soup = sphere_soup(rings, segments, 1.0);
+  const auto equator = [&](int j) { return std::uint32_t(1 + (rings / 2 - 1) * segments + j); };
+  const std::uint32_t first_out = std::uint32_t(soup.positions.size());
+  for (int j = 0; j <= 40; ++j) soup.positions.push_back(to_float(to_double(soup.positions[equator(j)]) * 1.2));
+  for (std::uint32_t j = 0; j < 40; ++j) {
+    soup.add_face({equator(j), equator(j + 1), first_out + j});
+    soup.add_face({equator(j + 1), first_out + j + 1, first_out + j});
+  }
+  ASSERT_GT(soup.n_faces(), 60000u);
+  const test::DefectCounts before = test::count_defects(soup);
+  ASSERT_EQ(before.non_manifold_edges, 40u);
+
+  RemeshOptions options;
+  options.iterations = 2;
+  std::vector<Mesh> results;
+  for (unsigned threads : {1u, 2u}) {
+    set_thread_count(threads);
+    Mesh mesh = mesh_of(soup);
+    const RemeshReport report = remesh(mesh, options);
+    set_thread_count(0);
+    EXPECT_GT(report.collapses, 10000u);
+    EXPECT_GT(report.flips, 10000u);
+    expect_valid(mesh);
+    const test::DefectCounts after = test::count_defects(extract(mesh));
+    EXPECT_EQ(after.non_manifold_edges, before.non_manifold_edges);
+    EXPECT_EQ(after.non_manifold_vertices, before.non_manifold_vertices);
+    EXPECT_EQ(after.duplicate_faces, 0u);
+    results.push_back(std::move(mesh));
+  }
+  ASSERT_EQ(results[0].n_faces(), results[1].n_faces());
+  EXPECT_EQ(results[0].positions(), results[1].positions());
+  for (Face f : results[0].faces()) {
+    std::vector<Vertex> a, b;
+    for (Vertex v : results[0].vertices(f)) a.push_back(v);
+    for (Vertex v : results[1].vertices(f)) b.push_back(v);
+    ASSERT_EQ(a, b);
   }
 }
 

@@ -3,6 +3,7 @@
 #include "hedge/remesh.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -54,6 +55,14 @@ constexpr int kMaxSplitRounds = 16;
 // No collapse merges two vertices whose valences add up to more than this (see may_collapse).
 constexpr std::int32_t kMaxCollapseValence = 40;
 
+// The collapse and flip passes in regions (Remesher::run_in_regions): from this many faces
+// on, in kPhases phases of regions of about kRegionVertices vertices, at least kMinRegions.
+constexpr std::size_t kRegionsMinFaces = 50000;
+constexpr std::size_t kRegionVertices = 16384;
+constexpr std::size_t kMinRegions = 32;
+constexpr int kPhases = 2;
+constexpr std::uint16_t kNoRegion = detail::RegionPartitions::kNone;
+
 // The area of the surface, polygons as fans of their vector area, in double precision (float
 // squares overflow near 1e19 and underflow near 1e-19).
 double surface_area(const Mesh& mesh) {
@@ -101,6 +110,30 @@ class Remesher {
   void split_long_edges();
   void collapse_short_edges();
   void equalize_valences();
+  // The collapse and flip passes: every edge once, then the edges near each change.
+  enum class Pass : std::uint8_t { collapse, flip };
+  // A pass's loop state: the whole mesh's, or one region's during a phase.
+  struct Worker {
+    std::uint16_t region = kNoRegion;  // changes only inside it; kNoRegion: anywhere
+    std::vector<Edge> pending;         // edges near a change, to visit again
+    std::vector<Edge> deferred;        // a region's: edges whose neighbourhood leaves it
+    Mesh::Deletions tally;
+    std::size_t changes = 0;
+  };
+  std::size_t run_pass(Pass pass);  // returns the number of changes
+  void run_in_regions(Pass pass);
+  bool is_candidate(Pass pass, Edge e) const;
+  void visit(Pass pass, Edge e, Worker& w);  // e, then the edges its changes put on w.pending
+  bool in_region(Vertex v, std::uint16_t region) const { return region_[v.idx()] == region && !copies_.is_copy(v); }
+  bool rings_inside(Vertex a, Vertex b, std::uint16_t region) const;
+  bool is_short(Edge e) const {  // live, no feature, and below 4/5 of its target length
+    if (mesh_.is_deleted(e) || (edge_flags_[e.idx()] & kFeature)) return false;
+    const Vertex a = mesh_.vertex(e, 0), b = mesh_.vertex(e, 1);
+    const double lo = 0.8 * size(a, b);
+    return length_sq(a, b) < lo * lo;
+  }
+  bool collapse_if_short(Edge e, Worker& w);
+  bool flip_if_better(Edge e, Worker& w);
   bool is_cap(Edge e) const;  // an angle at e's opposite corners near 180 degrees
   bool open_cap(Edge e);
   void open_caps();
@@ -116,7 +149,6 @@ class Remesher {
   bool star_ok(Vertex v, Vertex other, const Vec3d& target) const;
   bool may_collapse(Halfedge h, const Vec3d& target) const;
   bool makes_twin_triangle(Halfedge h) const;
-  bool flip_if_better(Edge e);
   void grow_vertex_arrays();
 
   // The input halfedges whose targets are the corners of surface triangle t, in the order
@@ -141,7 +173,7 @@ class Remesher {
     std::int32_t valence = 0, target = 6;  // target: 6 inside, 4 on the boundary
   };
   std::vector<Degree> degree_;
-  std::vector<Edge> work_;  // pending edges of the collapse and flip passes
+  std::vector<Edge> work_;  // pending edges of the cap-opening sweep
   std::vector<Index> surface_hint_, curve_hint_;
   std::vector<double> sizing_;                    // per vertex, adaptive only
   std::vector<double> input_sizing_;              // per input vertex, adaptive only
@@ -149,6 +181,12 @@ class Remesher {
   std::vector<Index> move_order_, order_starts_;  // smooth_and_project()'s order of the vertices
   std::vector<PropertyArray*> vertex_arrays_;     // blended on splits (non-internal)
   std::vector<PropertyArray*> corner_arrays_;     // continued on collapses (non-internal)
+  const std::uint16_t* region_ = nullptr;         // during a phase: each vertex's region
+  std::vector<Worker> workers_;                   // one per region
+  std::vector<Edge> deferred_;                    // the candidates no region could take
+  std::vector<std::vector<Edge>> offered_;        // a phase's edges, per part and region
+  std::vector<std::vector<Edge>> carried_;        // per part: its candidates across borders
+  detail::RegionPartitions partitions_;           // made by the first run_in_regions()
 };
 
 std::array<Halfedge, 3> Remesher::input_corners(Index t) const {
@@ -401,6 +439,7 @@ void Remesher::split_long_edges() {
       if (copies_.any() && copies_.edge_elsewhere(mesh_, a, b, e)) continue;
 
       Vertex v = mesh_.add_vertex(to_float((to_double(mesh_.position(a)) + to_double(mesh_.position(b))) * 0.5));
+      if (partitions_.size()) partitions_.append_like(a.idx());
       const Index from[2] = {a.idx(), b.idx()};
       const float half[2] = {0.5f, 0.5f};
       for (PropertyArray* p : vertex_arrays_) p->interpolate(v.idx(), from, half);
@@ -488,101 +527,215 @@ bool Remesher::may_collapse(Halfedge h, const Vec3d& target) const {
 
 // One pass over all edges, then the edges at each vertex a collapse moved, until none is
 // short and collapsible (every collapse removes a vertex, so it ends).
-void Remesher::collapse_short_edges() {
-  std::vector<Edge>& pending = work_;
-  pending.clear();
-  Index next_edge = 0;
-  for (;;) {
-    Edge e;
-    if (!pending.empty()) {
-      e = pending.back();
-      pending.pop_back();
-    } else if (next_edge < mesh_.edges_size()) {
-      e = Edge(next_edge++);
-    } else {
-      break;
-    }
-    const Index i = e.idx();
-    if (mesh_.is_deleted(e) || (edge_flags_[i] & kFeature)) continue;
-    Halfedge h = Mesh::halfedge(e, 0), o = Mesh::halfedge(e, 1);
-    Vertex a = mesh_.from_vertex(h), b = mesh_.to_vertex(h);
-    double lo = 0.8 * size(a, b);
-    if (length_sq(a, b) >= lo * lo) continue;
-    // Botsch & Kobbelt collapse to the midpoint, which leaves shorter edges than keeping
-    // an end; an end that may not move (fixed, or sliding off its curve) is kept instead.
-    const bool curve_edge = edge_flags_[i] & kCurve;
-    auto movable = [&](Vertex v) {
-      return kind_[v.idx()] == Kind::free || (kind_[v.idx()] == Kind::sliding && curve_edge);
-    };
-    const Vec3d pa = to_double(mesh_.position(a)), pb = to_double(mesh_.position(b));
-    const bool midpoint = movable(a) && movable(b);
-    const Vec3d mid = (pa + pb) * 0.5;
-    // Remove the vertex of lower valence when both ways are possible (pmp-library's
-    // choice): try that way first, the other only when it fails.
-    const bool a_first = degree_[a.idx()].valence <= degree_[b.idx()].valence;
-    const Halfedge first = a_first ? h : o, second = a_first ? o : h;
-    const Vec3d& first_target = midpoint ? mid : (a_first ? pb : pa);
-    const Vec3d& second_target = midpoint ? mid : (a_first ? pa : pb);
-    Halfedge c;
-    if (may_collapse(first, first_target))
-      c = first;
-    else if (may_collapse(second, second_target))
-      c = second;
-    else
-      continue;
-    const Halfedge co = Mesh::opposite(c);
-    const Vertex gone = mesh_.from_vertex(c), kept = mesh_.to_vertex(c);
+void Remesher::collapse_short_edges() { report_.collapses += run_pass(Pass::collapse); }
 
-    // The two triangles at the edge collapse: each merges its other two edges into the
-    // one at the kept vertex, which inherits the flags of the one that goes.
-    Vertex left = mesh_.is_boundary(c) ? Vertex() : mesh_.to_vertex(mesh_.next(c));
-    Vertex right = mesh_.is_boundary(co) ? Vertex() : mesh_.to_vertex(mesh_.next(co));
-    Edge left_kept, left_gone, right_kept, right_gone;
-    if (left.is_valid()) left_kept = Mesh::edge(mesh_.next(c)), left_gone = Mesh::edge(mesh_.prev(c));
-    if (right.is_valid()) right_kept = Mesh::edge(mesh_.prev(co)), right_gone = Mesh::edge(mesh_.next(co));
-    // Corners of the removed vertex's other faces move to the kept vertex: they take the
-    // kept vertex's corner of a collapsing triangle (same chart: the edge is no seam).
-    // Done before the collapse, which moves some of them onto surviving half-edges.
-    if (!corner_arrays_.empty()) {
-      const Halfedge source = left.is_valid() ? c : mesh_.prev(co);
-      for (Halfedge g : mesh_.outgoing(gone)) {
-        Halfedge in = Mesh::opposite(g);
-        if (mesh_.is_boundary(in) || in == mesh_.prev(c) || in == co) continue;
-        for (PropertyArray* p : corner_arrays_) p->copy_element(source.idx(), in.idx());
-      }
-    }
-    if (midpoint) {
-      const Index from[2] = {kept.idx(), gone.idx()};
-      const float half[2] = {0.5f, 0.5f};
-      for (PropertyArray* p : vertex_arrays_) p->interpolate(kept.idx(), from, half);
-      if (!sizing_.empty()) sizing_[kept.idx()] = 0.5 * (sizing_[kept.idx()] + sizing_[gone.idx()]);
-    }
+// One pass over all edges, then the four edges around each flip, until no flip helps.
+// Every flip lowers the sum of squared valence deviations, so it ends.
+void Remesher::equalize_valences() { report_.flips += run_pass(Pass::flip); }
 
-    mesh_.collapse_unchecked(c);  // may_collapse() has just run is_collapse_ok()
-    if (midpoint) mesh_.position(kept) = to_float(mid);
-    if (left.is_valid()) edge_flags_[left_kept.idx()] |= edge_flags_[left_gone.idx()];
-    if (right.is_valid()) edge_flags_[right_kept.idx()] |= edge_flags_[right_gone.idx()];
-    int valence = 0;
-    for (Halfedge g : mesh_.outgoing(kept)) {
-      ++valence;
-      pending.push_back(Mesh::edge(g));
-    }
-    degree_[kept.idx()].valence = valence;
-    degree_[kept.idx()].target = std::min(degree_[kept.idx()].target, degree_[gone.idx()].target);
-    if (left.is_valid()) --degree_[left.idx()].valence;
-    if (right.is_valid()) --degree_[right.idx()].valence;
-    ++report_.collapses;
+// Edges in index order, each followed by the edges its change puts on `pending`. On a large
+// mesh the regions do most of it first, on all threads, and this loop visits only the edges
+// they left.
+std::size_t Remesher::run_pass(Pass pass) {
+  mesh_.prepare_deletion_marks();
+  Worker all;
+  if (mesh_.n_faces() >= kRegionsMinFaces) {
+    run_in_regions(pass);
+    for (Edge e : deferred_) visit(pass, e, all);
+    for (Worker& w : workers_) all.changes += std::exchange(w.changes, 0);
+  } else {
+    for (Index i = 0; i < mesh_.edges_size(); ++i) visit(pass, Edge(i), all);
   }
+  mesh_.add_deletions(all.tally);
+  return all.changes;
+}
+
+bool Remesher::is_candidate(Pass pass, Edge e) const {
+  if (pass == Pass::collapse) return is_short(e);
+  return !mesh_.is_deleted(e) && !(edge_flags_[e.idx()] & kFeature) && !mesh_.is_boundary(e);
+}
+
+void Remesher::visit(Pass pass, Edge e, Worker& w) {
+  w.pending.assign(1, e);
+  while (!w.pending.empty()) {
+    const Edge x = w.pending.back();
+    w.pending.pop_back();
+    if (pass == Pass::collapse ? collapse_if_short(x, w) : flip_if_better(x, w)) ++w.changes;
+  }
+}
+
+// Whether the one-rings of a and b lie in `region` and hold no vertex the weld joins with
+// another: then collapsing their edge reads and changes only faces whose corners all lie in
+// the region, which no other region's changes read or change.
+bool Remesher::rings_inside(Vertex a, Vertex b, std::uint16_t region) const {
+  for (Vertex v : {a, b}) {
+    if (!in_region(v, region)) return false;
+    for (Halfedge g : mesh_.outgoing(v))
+      if (!in_region(mesh_.to_vertex(g), region)) return false;
+  }
+  return true;
+}
+
+// The regions of a partition of the vertices (spatial_order.h), each on its own thread,
+// visit their candidate edges in index order, changing only faces whose corners all lie
+// inside them: regions never meet, and the result does not depend on the number of threads.
+// An edge whose change would reach out of its region waits for the next phase, whose
+// partition has its borders elsewhere; those left after the last phase go to deferred_.
+void Remesher::run_in_regions(Pass pass) {
+  // The partitions are made once, of the vertices there are then; every vertex a split adds
+  // later joins one of its edge's ends (split_long_edges).
+  if (partitions_.regions() == 0) {
+    const std::size_t nv = mesh_.vertices_size();
+    const detail::Frame frame = detail::normalized_frame(mesh_);
+    partitions_ = detail::RegionPartitions(
+        nv, std::max(nv / kRegionVertices, kMinRegions),
+        [&](std::size_t i) {
+          return to_float((to_double(mesh_.position(Vertex(Index(i)))) - frame.center) / frame.scale);
+        },
+        0);
+  }
+  const std::size_t regions = partitions_.regions();
+  workers_.resize(regions);
+  for (std::size_t r = 0; r < regions; ++r) workers_[r].region = std::uint16_t(r);
+  const unsigned threads = thread_count();
+  for (int phase = 0; phase < kPhases; ++phase) {
+    region_ = partitions_.phase(phase);
+    // The first phase offers every edge, the next those the last deferred: the candidates
+    // go to their region's list, or to `carried` when their ends lie in two. On all
+    // threads, each part a run of the edges, so that every list is in edge order.
+    const std::size_t n = phase == 0 ? mesh_.edges_size() : deferred_.size();
+    const std::size_t parts = std::max<std::size_t>(1, std::min<std::size_t>(threads, n / 16384));
+    offered_.resize(parts * regions);
+    carried_.resize(parts);
+    for (std::vector<Edge>& list : offered_) list.clear();
+    for (std::vector<Edge>& list : carried_) list.clear();
+    hedge::parallel_for(
+        parts, threads,
+        [&](std::size_t begin, std::size_t end) {
+          for (std::size_t k = begin; k < end; ++k)
+            for (std::size_t j = n * k / parts; j < n * (k + 1) / parts; ++j) {
+              const Edge e = phase == 0 ? Edge(Index(j)) : deferred_[j];
+              if (!is_candidate(pass, e)) continue;
+              const std::uint16_t r = region_[mesh_.vertex(e, 0).idx()];
+              (r == region_[mesh_.vertex(e, 1).idx()] ? offered_[k * regions + r] : carried_[k]).push_back(e);
+            }
+        },
+        1);
+    // The regions, each thread taking the next one left.
+    std::atomic<std::size_t> next{0};
+    hedge::parallel_for(
+        threads, threads,
+        [&](std::size_t begin, std::size_t end) {
+          for (std::size_t t = begin; t < end; ++t)
+            for (std::size_t r; (r = next.fetch_add(1)) < regions;)
+              for (std::size_t k = 0; k < parts; ++k)
+                for (Edge e : offered_[k * regions + r]) visit(pass, e, workers_[r]);
+        },
+        1);
+    deferred_.clear();
+    for (const std::vector<Edge>& list : carried_) deferred_.insert(deferred_.end(), list.begin(), list.end());
+    for (Worker& w : workers_) {
+      mesh_.add_deletions(std::exchange(w.tally, {}));
+      deferred_.insert(deferred_.end(), w.deferred.begin(), w.deferred.end());
+      w.deferred.clear();
+    }
+    std::sort(deferred_.begin(), deferred_.end());
+    deferred_.erase(std::unique(deferred_.begin(), deferred_.end()), deferred_.end());
+  }
+  region_ = nullptr;
+}
+
+// Botsch & Kobbelt's collapse of e when it is shorter than 4/5 of its target length and may
+// go; the edges at the kept vertex go on w.pending.
+bool Remesher::collapse_if_short(Edge e, Worker& w) {
+  const Index i = e.idx();
+  Halfedge h = Mesh::halfedge(e, 0), o = Mesh::halfedge(e, 1);
+  Vertex a = mesh_.from_vertex(h), b = mesh_.to_vertex(h);
+  if (!is_short(e)) return false;
+  if (w.region != kNoRegion && !rings_inside(a, b, w.region)) {
+    w.deferred.push_back(e);
+    return false;
+  }
+  // Botsch & Kobbelt collapse to the midpoint, which leaves shorter edges than keeping
+  // an end; an end that may not move (fixed, or sliding off its curve) is kept instead.
+  const bool curve_edge = edge_flags_[i] & kCurve;
+  auto movable = [&](Vertex v) {
+    return kind_[v.idx()] == Kind::free || (kind_[v.idx()] == Kind::sliding && curve_edge);
+  };
+  const Vec3d pa = to_double(mesh_.position(a)), pb = to_double(mesh_.position(b));
+  const bool midpoint = movable(a) && movable(b);
+  const Vec3d mid = (pa + pb) * 0.5;
+  // Remove the vertex of lower valence when both ways are possible (pmp-library's
+  // choice): try that way first, the other only when it fails.
+  const bool a_first = degree_[a.idx()].valence <= degree_[b.idx()].valence;
+  const Halfedge first = a_first ? h : o, second = a_first ? o : h;
+  const Vec3d& first_target = midpoint ? mid : (a_first ? pb : pa);
+  const Vec3d& second_target = midpoint ? mid : (a_first ? pa : pb);
+  Halfedge h_gone;
+  if (may_collapse(first, first_target))
+    h_gone = first;
+  else if (may_collapse(second, second_target))
+    h_gone = second;
+  else
+    return false;
+  const Halfedge co = Mesh::opposite(h_gone);
+  const Vertex gone = mesh_.from_vertex(h_gone), kept = mesh_.to_vertex(h_gone);
+
+  // The two triangles at the edge collapse: each merges its other two edges into the
+  // one at the kept vertex, which inherits the flags of the one that goes.
+  Vertex left = mesh_.is_boundary(h_gone) ? Vertex() : mesh_.to_vertex(mesh_.next(h_gone));
+  Vertex right = mesh_.is_boundary(co) ? Vertex() : mesh_.to_vertex(mesh_.next(co));
+  Edge left_kept, left_gone, right_kept, right_gone;
+  if (left.is_valid()) left_kept = Mesh::edge(mesh_.next(h_gone)), left_gone = Mesh::edge(mesh_.prev(h_gone));
+  if (right.is_valid()) right_kept = Mesh::edge(mesh_.prev(co)), right_gone = Mesh::edge(mesh_.next(co));
+  // Corners of the removed vertex's other faces move to the kept vertex: they take the
+  // kept vertex's corner of a collapsing triangle (same chart: the edge is no seam).
+  // Done before the collapse, which moves some of them onto surviving half-edges.
+  if (!corner_arrays_.empty()) {
+    const Halfedge source = left.is_valid() ? h_gone : mesh_.prev(co);
+    for (Halfedge g : mesh_.outgoing(gone)) {
+      Halfedge in = Mesh::opposite(g);
+      if (mesh_.is_boundary(in) || in == mesh_.prev(h_gone) || in == co) continue;
+      for (PropertyArray* p : corner_arrays_) p->copy_element(source.idx(), in.idx());
+    }
+  }
+  if (midpoint) {
+    const Index from[2] = {kept.idx(), gone.idx()};
+    const float half[2] = {0.5f, 0.5f};
+    for (PropertyArray* p : vertex_arrays_) p->interpolate(kept.idx(), from, half);
+    if (!sizing_.empty()) sizing_[kept.idx()] = 0.5 * (sizing_[kept.idx()] + sizing_[gone.idx()]);
+  }
+
+  mesh_.collapse_unchecked(h_gone, w.tally);  // may_collapse() has just run is_collapse_ok()
+  if (midpoint) mesh_.position(kept) = to_float(mid);
+  if (left.is_valid()) edge_flags_[left_kept.idx()] |= edge_flags_[left_gone.idx()];
+  if (right.is_valid()) edge_flags_[right_kept.idx()] |= edge_flags_[right_gone.idx()];
+  int valence = 0;
+  for (Halfedge g : mesh_.outgoing(kept)) {
+    ++valence;
+    w.pending.push_back(Mesh::edge(g));
+  }
+  degree_[kept.idx()].valence = valence;
+  degree_[kept.idx()].target = std::min(degree_[kept.idx()].target, degree_[gone.idx()].target);
+  if (left.is_valid()) --degree_[left.idx()].valence;
+  if (right.is_valid()) --degree_[right.idx()].valence;
+  return true;
 }
 
 // Whether flipping e brings the valences of its four vertices closer to their targets (6
 // inside, 4 on the boundary) and keeps the surface from folding; flips it if so.
-bool Remesher::flip_if_better(Edge e) {
+bool Remesher::flip_if_better(Edge e, Worker& w) {
   const Index i = e.idx();
   if (mesh_.is_deleted(e) || (edge_flags_[i] & kFeature) || mesh_.is_boundary(e)) return false;
   Halfedge h0 = Mesh::halfedge(e, 0), h1 = Mesh::halfedge(e, 1);
   Vertex a = mesh_.to_vertex(h0), b = mesh_.to_vertex(h1);
   Vertex c = mesh_.to_vertex(mesh_.next(h0)), d = mesh_.to_vertex(mesh_.next(h1));
+  // In a region, the quad's corners must lie in it: the flip changes only its two faces.
+  if (w.region != kNoRegion &&
+      !(in_region(a, w.region) && in_region(b, w.region) && in_region(c, w.region) && in_region(d, w.region))) {
+    w.deferred.push_back(e);
+    return false;
+  }
   Degree& da = degree_[a.idx()];
   Degree& db = degree_[b.idx()];
   Degree& dc = degree_[c.idx()];
@@ -609,30 +762,12 @@ bool Remesher::flip_if_better(Edge e) {
   if (!mesh_.is_flip_ok(e) || copies_.meets_flip(mesh_, e)) return false;
   mesh_.flip(e);
   --da.valence, --db.valence, ++dc.valence, ++dd.valence;
-  ++report_.flips;
-  return true;
-}
-
-// One pass over all edges, then the four edges around each flip, until no flip helps.
-// Every flip lowers the sum of squared valence deviations, so it ends.
-void Remesher::equalize_valences() {
-  std::vector<Edge>& pending = work_;
-  pending.clear();
-  auto push_quad = [&](Edge e) {
-    for (unsigned side = 0; side < 2; ++side) {
-      Halfedge h = Mesh::halfedge(e, side);
-      pending.push_back(Mesh::edge(mesh_.next(h)));
-      pending.push_back(Mesh::edge(mesh_.prev(h)));
-    }
-  };
-  for (Index i = 0; i < mesh_.edges_size(); ++i) {
-    if (flip_if_better(Edge(i))) push_quad(Edge(i));
-    while (!pending.empty()) {
-      Edge e = pending.back();
-      pending.pop_back();
-      if (flip_if_better(e)) push_quad(e);
-    }
+  for (unsigned side = 0; side < 2; ++side) {
+    const Halfedge h = Mesh::halfedge(e, side);
+    w.pending.push_back(Mesh::edge(mesh_.next(h)));
+    w.pending.push_back(Mesh::edge(mesh_.prev(h)));
   }
+  return true;
 }
 
 // The last smoothing and projection can leave caps: a vertex pushed onto (or near) the
