@@ -288,7 +288,6 @@ GarbageMaps Mesh::garbage_collect() {
       for (std::size_t i = 0; i < n; ++i) map[i] = static_cast<Index>(i);
     };
     identity(maps.vertices, vertices_size());
-    identity(maps.halfedges, halfedges_size());
     identity(maps.edges, edges_size());
     identity(maps.faces, faces_size());
     return maps;
@@ -333,17 +332,14 @@ GarbageMaps Mesh::renumber(std::span<const Index> vkeep, std::span<const Index> 
   old_to_new(maps.vertices, vertices_size(), vkeep);
   old_to_new(maps.edges, edges_size(), ekeep);
   old_to_new(maps.faces, faces_size(), fkeep);
-  maps.halfedges.assign(halfedges_size(), kInvalidIndex);
   std::vector<Index> hkeep;
   hkeep.reserve(2 * ekeep.size());
   for (Index e : ekeep) {
-    maps.halfedges[2 * e] = static_cast<Index>(hkeep.size());
     hkeep.push_back(2 * e);
-    maps.halfedges[2 * e + 1] = static_cast<Index>(hkeep.size());
     hkeep.push_back(2 * e + 1);
   }
 
-  auto map_h = [&](Halfedge h) { return h.is_valid() ? Halfedge(maps.halfedges[h.idx()]) : h; };
+  auto map_h = [&](Halfedge h) { return h.is_valid() ? Halfedge(maps.halfedge(h.idx())) : h; };
   auto map_v = [&](Vertex v) { return v.is_valid() ? Vertex(maps.vertices[v.idx()]) : v; };
   auto map_f = [&](Face f) { return f.is_valid() ? Face(maps.faces[f.idx()]) : f; };
 

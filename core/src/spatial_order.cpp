@@ -43,6 +43,7 @@ std::uint32_t morton_cell(const Vec3f& p, double offset, int bits) {
   std::uint32_t code = 0;
   for (int axis = 0; axis < 3; ++axis) {
     double x = double(p[axis]) + 0.5 + offset;
+    if (!(std::abs(x) < 1e9)) x = 0;         // not finite, or far out of the frame: any cell serves
     x -= double(static_cast<long long>(x));  // wrapped into [0, 1) (towards zero, then up)
     if (x < 0) x += 1;
     const int q = std::clamp(int(x * (1 << bits)), 0, (1 << bits) - 1);
@@ -110,10 +111,12 @@ GarbageMaps sort_spatially(Mesh& m, unsigned threads) {
   return m.reorder(vertices, edges, faces);
 }
 
-RegionPartitions::RegionPartitions(std::size_t n, std::size_t regions, const std::function<Vec3f(std::size_t)>& place,
+RegionPartitions::RegionPartitions(const Mesh& m, const Vec3d& center, double inv_scale, std::size_t regions,
                                    unsigned threads)
     : regions_(std::clamp<std::size_t>(regions, 1, kNone - 1)) {
+  const std::size_t n = m.vertices_size();
   if (n == 0) return;
+  const std::vector<Point>& positions = m.positions();
   // Cells: 64 per axis up to 2 million vertices, 128 above.
   const int bits = n <= (std::size_t(1) << 21) ? 6 : 7;
   const std::size_t n_cells = std::size_t(1) << (3 * bits);
@@ -121,8 +124,10 @@ RegionPartitions::RegionPartitions(std::size_t n, std::size_t regions, const std
   std::vector<std::size_t> cell_start(n_cells + 1);
   std::vector<std::uint16_t> region_of_cell(n_cells);
   for (int grid = 0; grid < 2; ++grid) {
+    const double offset = grid / 3.0;
     parallel_for(n, threads, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t i = begin; i < end; ++i) cell[i] = morton_cell(place(i), grid / 3.0, bits);
+      for (std::size_t i = begin; i < end; ++i)
+        cell[i] = morton_cell(to_float((to_double(positions[i]) - center) * inv_scale), offset, bits);
     });
     std::fill(cell_start.begin(), cell_start.end(), 0);
     for (std::size_t i = 0; i < n; ++i) ++cell_start[cell[i] + 1];

@@ -6,7 +6,6 @@
 #pragma once
 
 #include <cstdint>
-#include <functional>
 #include <vector>
 
 #include "hedge/mesh.h"
@@ -44,10 +43,9 @@ class RegionPartitions {
   static constexpr std::uint16_t kNone = 0xffff;  //!< no region: never a vertex's
 
   RegionPartitions() = default;
-  //! `place(i)`: vertex i's place in the normalized frame (any place for a deleted one).
-  //! `regions` is clamped to [1, kNone - 1].
-  RegionPartitions(std::size_t n, std::size_t regions, const std::function<Vec3f(std::size_t)>& place,
-                   unsigned threads);
+  //! Of m's vertices, placed by (position - center) * inv_scale (a normalized frame; deleted
+  //! vertices too, wherever they were left). `regions` is clamped to [1, kNone - 1].
+  RegionPartitions(const Mesh& m, const Vec3d& center, double inv_scale, std::size_t regions, unsigned threads);
 
   std::size_t regions() const { return regions_; }
   //! How many vertices the partitions cover.

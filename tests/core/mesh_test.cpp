@@ -218,6 +218,11 @@ TEST(Mesh, DeleteFaceAndGarbageCollect) {
   EXPECT_EQ(maps.vertices[0], kInvalidIndex);
   EXPECT_EQ(maps.vertices[1], 0u);  // relative order kept
   EXPECT_EQ(maps.faces[1], 0u);
+  // A half-edge keeps its side of its edge.
+  for (Index e = 0; e < maps.edges.size(); ++e)
+    for (Index side = 0; side < 2; ++side)
+      EXPECT_EQ(maps.halfedge(2 * e + side), maps.edges[e] == kInvalidIndex ? kInvalidIndex : 2 * maps.edges[e] + side);
+  EXPECT_EQ(std::count(maps.edges.begin(), maps.edges.end(), kInvalidIndex), 2);  // the corner's two edges
   EXPECT_EQ(tag[Vertex(0)], 10);  // properties moved with their vertices
   EXPECT_EQ(tag[Vertex(7)], 80);
   EXPECT_EQ(m.position(Vertex(0)), (Point{{1, 0, 0}}));

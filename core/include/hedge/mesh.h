@@ -125,7 +125,14 @@ struct LoopRange {
 
 //! Index maps returned by garbage_collect(): old index -> new index (invalid when deleted).
 struct GarbageMaps {
-  std::vector<Index> vertices, halfedges, edges, faces;
+  std::vector<Index> vertices, edges, faces;
+  //! A half-edge's new index: the two half-edges of an edge stay together, in their order,
+  //! so this is its edge's new index with the same side (no array of its own: a mesh has
+  //! twice as many half-edges as edges, and the map would be the largest of all).
+  Index halfedge(Index old) const {
+    const Index e = edges[old >> 1];
+    return e == kInvalidIndex ? kInvalidIndex : 2 * e + (old & 1);
+  }
 };
 
 class Mesh {

@@ -949,9 +949,8 @@ void Decimator::collapse_in_regions() {
   const std::size_t vertices = m_.vertices_size();
   // Regions small enough to stay in cache. The cells are of the vertices' places at the
   // start: any partition serves, this one keeps regions compact.
-  partitions_ = detail::RegionPartitions(
-      vertices, std::max(vertices / kRegionVertices, kMinRegions), [&](std::size_t i) { return vd_[i].position; },
-      opt_.threads);
+  partitions_ = detail::RegionPartitions(m_, center_, inv_scale_, std::max(vertices / kRegionVertices, kMinRegions),
+                                         opt_.threads);
   regions_ = partitions_.regions();
   live_edges_.resize(m_.edges_size());
   for (std::size_t i = 0; i < live_edges_.size(); ++i) live_edges_[i] = Index(i);

@@ -587,12 +587,8 @@ void Remesher::run_in_regions(Pass pass) {
   if (partitions_.regions() == 0) {
     const std::size_t nv = mesh_.vertices_size();
     const detail::Frame frame = detail::normalized_frame(mesh_);
-    partitions_ = detail::RegionPartitions(
-        nv, std::max(nv / kRegionVertices, kMinRegions),
-        [&](std::size_t i) {
-          return to_float((to_double(mesh_.position(Vertex(Index(i)))) - frame.center) / frame.scale);
-        },
-        0);
+    partitions_ =
+        detail::RegionPartitions(mesh_, frame.center, 1 / frame.scale, std::max(nv / kRegionVertices, kMinRegions), 0);
   }
   const std::size_t regions = partitions_.regions();
   workers_.resize(regions);
