@@ -191,7 +191,7 @@ int run_scale(const std::string& dragon_path, bool growth_only) {
   const Size sizes[] = {{"dragon decimated to 100k", 0, 100000, 5},
                         {"dragon", 0, 0, 3},
                         {"dragon, 1x Loop", 1, 0, 2},
-                        {"dragon, 2x Loop", 2, 0, 1}};
+                        {"dragon, 2x Loop", 2, 0, 2}};
   for (const Size& s : sizes) {
     hedge::Soup soup;
     {
