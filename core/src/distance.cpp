@@ -11,6 +11,7 @@
 
 #include "hedge/error.h"
 #include "hedge/threads.h"
+#include "parallel.h"
 
 namespace hedge {
 
@@ -316,13 +317,17 @@ void TriangleTree::build(std::vector<Triangle> tris, std::vector<Index> original
   const std::size_t n = tris.size();
   if (n >= kInvalidIndex / 2) throw Error("too many triangles for the distance tree");
   std::vector<Ref> refs(n);
+  parallel_for(n, 0, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      const Triangle& t = tris[i];
+      Ref& r = refs[i];
+      for (const Point* p : {&t.a, &t.b, &t.c}) r.box.add((*p)[0], (*p)[1], (*p)[2]);
+      for (int k = 0; k < 3; ++k) r.c[k] = (t.a[k] + t.b[k] + t.c[k]) / 3.0f;
+      r.id = static_cast<Index>(i);
+    }
+  });
   Box box, cbox;
-  for (std::size_t i = 0; i < n; ++i) {
-    const Triangle& t = tris[i];
-    Ref& r = refs[i];
-    for (const Point* p : {&t.a, &t.b, &t.c}) r.box.add((*p)[0], (*p)[1], (*p)[2]);
-    for (int k = 0; k < 3; ++k) r.c[k] = (t.a[k] + t.b[k] + t.c[k]) / 3.0f;
-    r.id = static_cast<Index>(i);
+  for (const Ref& r : refs) {
     box.add(r.box);
     cbox.add(r.c[0], r.c[1], r.c[2]);
   }
@@ -345,12 +350,14 @@ void TriangleTree::build(std::vector<Triangle> tris, std::vector<Index> original
   triangles_.resize(n);
   original_.resize(n);
   position_.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    Index from = refs[i].id;
-    triangles_[i] = tris[from];
-    original_[i] = original[from];
-    position_[original_[i]] = static_cast<Index>(i);
-  }
+  parallel_for(n, 0, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      const Index from = refs[i].id;
+      triangles_[i] = tris[from];
+      original_[i] = original[from];
+      position_[original_[i]] = static_cast<Index>(i);  // `original` is a permutation: no two write one place
+    }
+  });
 }
 
 std::array<Vec3d, 3> TriangleTree::corners(Index triangle) const {
