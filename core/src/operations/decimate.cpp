@@ -572,6 +572,9 @@ void Decimator::compute_quadrics() {
       const Vertex v(static_cast<Index>(i));
       if (m_.is_deleted(v) || !m_.halfedge(v).is_valid()) continue;
       Quadric q = face_planes(v, [&](Vertex w) { return at(w); });
+      // Counted here, while the ring face_planes() has just walked is still in cache.
+      vd_[i].valence =
+          static_cast<std::uint16_t>(std::min<std::size_t>(m_.valence(v), std::numeric_limits<std::uint16_t>::max()));
       boundary |= add_boundary_planes(v, q);
       // A weight scales every plane of the vertex, and so its share of a merged quadric: the
       // cost rises where detail matters while cost / weight stays a mean squared distance.
@@ -713,8 +716,6 @@ void Decimator::classify_vertices() {
     for (std::size_t i = begin; i < end; ++i) {
       const Vertex v(static_cast<Index>(i));
       if (m_.is_deleted(v)) continue;
-      vd_[i].valence =
-          static_cast<std::uint16_t>(std::min<std::size_t>(m_.valence(v), std::numeric_limits<std::uint16_t>::max()));
       std::uint8_t f = m_.is_boundary(v) ? kBoundary : 0;
       if (seam_mode_) f |= classify(v);
       if (!inside_selection_.empty() && !inside_selection_[i]) f |= kLocked;
