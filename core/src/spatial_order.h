@@ -32,12 +32,13 @@ std::uint32_t morton_cell(const Vec3f& p, double offset, int bits);
 //! numbering is.
 GarbageMaps sort_spatially(Mesh& m, unsigned threads = 0);
 
-//! Four partitions of n vertices into regions, for work done region by region on several
-//! threads in phases (decimation's and remeshing's collapses): regions are runs of about
-//! equal numbers of vertices along the Morton order of two grids a third of the box apart
-//! (so that the great planes of one grid's octree, where regions always part, are not the
-//! other's), each run shifted by half a run or not. Phases take them in turn (phase(k)), so
-//! that what lay on one phase's borders lies inside the next phase's regions.
+//! Four partitions of a mesh's vertices into regions, for work done region by region on
+//! several threads in phases (decimation's collapses, remeshing's collapses and flips).
+//! Regions are runs of about equal numbers of vertices along the Morton order of two grids a
+//! third of the box apart (so that the great planes of one grid's octree, where regions
+//! always part, are not the other's), each run shifted by half a run or not. Phases take
+//! them in turn (phase(k)), so that what lay on one phase's borders lies inside the next
+//! phase's regions.
 class RegionPartitions {
  public:
   static constexpr std::uint16_t kNone = 0xffff;  //!< no region: never a vertex's
