@@ -218,7 +218,7 @@ def steps():
     assert len(sphere.data.polygons) < sphere_faces / 2 and all(len(k.data) == len(sphere.data.vertices) for k in keys)
     vertices = len(sphere.data.vertices)
     with bpy.context.temp_override(window=win, area=area, region=region(area, 'WINDOW')):
-        bpy.ops.mesh.hedge_remesh('INVOKE_DEFAULT', target_edge_length=0.02, iterations=20)
+        bpy.ops.mesh.hedge_remesh('INVOKE_DEFAULT', target_edge_length=0.01, iterations=20)
     yield 0.2
     assert "remesh" in operators.running, "the keyed remesh finished at once"
     keys["Dent"].name = "Renamed"
