@@ -21,21 +21,34 @@ std::uint32_t spread_bits(std::uint32_t x) {
   return x;
 }
 
-// Sorts `items` stably by key(item), a code of 3 * kBits bits: a radix sort, kBits a pass.
-template <class Key>
-void sort_by_code(std::vector<Index>& items, Key key) {
+// Sorts (code << 32 | index) pairs by their codes of 3 * kBits bits, stably: a radix sort,
+// kBits a pass, over the pairs themselves (no lookups of the codes through the indices).
+void sort_by_code(std::vector<std::uint64_t>& items) {
   constexpr int kBits = 10;
-  std::vector<Index> scratch(items.size());
+  std::vector<std::uint64_t> scratch(items.size());
   std::vector<std::size_t> start((std::size_t(1) << kBits) + 1);
   for (int pass = 0; pass < 3; ++pass) {
-    const int shift = pass * kBits;
-    auto digit = [&](Index i) { return (key(i) >> shift) & ((1u << kBits) - 1); };
+    const int shift = 32 + pass * kBits;
+    auto digit = [&](std::uint64_t x) { return std::size_t(x >> shift) & ((std::size_t(1) << kBits) - 1); };
     std::fill(start.begin(), start.end(), 0);
-    for (Index i : items) ++start[digit(i) + 1];
+    for (std::uint64_t x : items) ++start[digit(x) + 1];
     for (std::size_t b = 1; b < start.size(); ++b) start[b] += start[b - 1];
-    for (Index i : items) scratch[start[digit(i)]++] = i;
+    for (std::uint64_t x : items) scratch[start[digit(x)]++] = x;
     items.swap(scratch);
   }
+}
+
+// The items 0..n-1 that are live, ordered by bucket (below `buckets`), stably: a counting sort.
+template <class IsLive, class Bucket>
+std::vector<Index> order_by_bucket(std::size_t n, std::size_t live, std::size_t buckets, IsLive is_live,
+                                   Bucket bucket) {
+  std::vector<Index> key(n), start(buckets + 1, 0), out(live);
+  for (std::size_t i = 0; i < n; ++i)
+    if (is_live(Index(i))) ++start[(key[i] = bucket(Index(i))) + 1];
+  for (std::size_t b = 1; b < start.size(); ++b) start[b] += start[b - 1];
+  for (std::size_t i = 0; i < n; ++i)
+    if (is_live(Index(i))) out[start[key[i]]++] = Index(i);
+  return out;
 }
 }  // namespace
 
@@ -65,49 +78,42 @@ Frame normalized_frame(const Mesh& m) {
 }
 
 GarbageMaps sort_spatially(Mesh& m, unsigned threads) {
-  // 1. The normalized frame.
+  // 1. The live vertices along the Morton order of their cells (10 bits per axis) in the
+  // normalized frame; the codes on all threads.
   const Frame frame = normalized_frame(m);
-
-  // 2. The cells (10 bits per axis) of the live vertices and of the faces' centroids, on
-  // all threads; both sorted by cell.
   constexpr int kBits = 10;
-  auto cell = [&](const Vec3d& p) { return morton_cell(to_float((p - frame.center) / frame.scale), 0, kBits); };
-  std::vector<std::uint32_t> vertex_cell(m.vertices_size()), face_cell(m.faces_size());
+  std::vector<std::uint64_t> coded(m.vertices_size());
   parallel_for(m.vertices_size(), threads, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i)
-      if (!m.is_deleted(Vertex(static_cast<Index>(i)))) vertex_cell[i] = cell(to_double(m.position(Vertex(Index(i)))));
-  });
-  parallel_for(m.faces_size(), threads, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
-      const Face f(static_cast<Index>(i));
-      if (m.is_deleted(f)) continue;
-      Vec3d sum{};
-      int n = 0;
-      for (Vertex v : m.vertices(f)) sum += to_double(m.position(v)), ++n;
-      face_cell[i] = cell(sum / double(n));
+      const Vertex v(static_cast<Index>(i));
+      const std::uint64_t code =
+          m.is_deleted(v) ? 0
+                          : morton_cell(to_float((to_double(m.position(v)) - frame.center) / frame.scale), 0, kBits);
+      coded[i] = code << 32 | i;
     }
   });
-  std::vector<Index> vertices, faces, edges;
-  vertices.reserve(m.n_vertices());
-  for (Vertex v : m.vertices()) vertices.push_back(v.idx());
-  sort_by_code(vertices, [&](Index i) { return vertex_cell[i]; });
-  faces.reserve(m.n_faces());
-  for (Face f : m.faces()) faces.push_back(f.idx());
-  sort_by_code(faces, [&](Index i) { return face_cell[i]; });
-
-  // 3. Edges by the place of their first end in the new vertex order (a counting sort).
-  std::vector<Index> place(m.vertices_size());
-  for (std::size_t i = 0; i < vertices.size(); ++i) place[vertices[i]] = static_cast<Index>(i);
-  std::vector<Index> first_end(m.edges_size());
-  std::vector<std::size_t> start(vertices.size() + 1, 0);
-  for (Edge e : m.edges()) {
-    first_end[e.idx()] = std::min(place[m.vertex(e, 0).idx()], place[m.vertex(e, 1).idx()]);
-    ++start[first_end[e.idx()] + 1];
+  std::erase_if(coded, [&](std::uint64_t x) { return m.is_deleted(Vertex(Index(x))); });
+  sort_by_code(coded);
+  std::vector<Index> vertices(coded.size()), place(m.vertices_size(), kInvalidIndex);
+  for (std::size_t i = 0; i < coded.size(); ++i) {
+    vertices[i] = Index(coded[i]);
+    place[vertices[i]] = Index(i);
   }
-  for (std::size_t b = 1; b < start.size(); ++b) start[b] += start[b - 1];
-  edges.resize(m.n_edges());
-  for (Edge e : m.edges()) edges[start[first_end[e.idx()]]++] = e.idx();
+  coded = {};
 
+  // 2. Faces and edges by the first of their vertices in that order: a face's neighbours
+  // share its vertices, so they land next to it.
+  const std::size_t n_places = vertices.size();
+  const std::vector<Index> faces = order_by_bucket(
+      m.faces_size(), m.n_faces(), n_places, [&](Index i) { return !m.is_deleted(Face(i)); },
+      [&](Index i) {
+        Index first = kInvalidIndex;
+        for (Vertex v : m.vertices(Face(i))) first = std::min(first, place[v.idx()]);
+        return first;
+      });
+  const std::vector<Index> edges = order_by_bucket(
+      m.edges_size(), m.n_edges(), n_places, [&](Index i) { return !m.is_deleted(Edge(i)); },
+      [&](Index i) { return std::min(place[m.vertex(Edge(i), 0).idx()], place[m.vertex(Edge(i), 1).idx()]); });
   return m.reorder(vertices, edges, faces);
 }
 

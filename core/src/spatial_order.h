@@ -26,10 +26,9 @@ Frame normalized_frame(const Mesh& m);
 //! `offset` (wrapping around).
 std::uint32_t morton_cell(const Vec3f& p, double offset, int bits);
 
-//! Renumbers m: vertices along the Morton order of their places, faces along that of their
-//! centroids, edges by the new number of their first end. Deleted elements go, as in
-//! garbage_collect(). Geometry, attributes and connectivity are unchanged; only the
-//! numbering is.
+//! Renumbers m: vertices along the Morton order of their places, faces and edges by the new
+//! number of their first vertex. Deleted elements go, as in garbage_collect(). Geometry,
+//! attributes and connectivity are unchanged; only the numbering is.
 GarbageMaps sort_spatially(Mesh& m, unsigned threads = 0);
 
 //! Four partitions of a mesh's vertices into regions, for work done region by region on
