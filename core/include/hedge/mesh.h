@@ -188,6 +188,11 @@ class Mesh {
   void prefetch(Halfedge h) const { detail::prefetch(&halfedges_[h.idx()]); }
   //! The same for f's half-edge.
   void prefetch(Face f) const { detail::prefetch(&face_halfedge_[f.idx()]); }
+  //! The same for e's half-edges and its deletion mark.
+  void prefetch(Edge e) const {
+    detail::prefetch(&halfedges_[halfedge(e, 0).idx()]);
+    if (!edeleted_.empty()) detail::prefetch(&edeleted_[e.idx()]);
+  }
   //! The same for v's outgoing half-edge and position.
   void prefetch(Vertex v) const {
     detail::prefetch(&vertex_halfedge_[v.idx()]);

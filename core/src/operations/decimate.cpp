@@ -860,7 +860,7 @@ void Decimator::start_fetch_ahead(Scratch& s, Index edge) const {
   if (edge == kInvalidIndex) return;
   s.ahead_edge = Edge(edge);
   s.ahead_stage = 1;
-  m_.prefetch(Mesh::halfedge(s.ahead_edge, 0));
+  m_.prefetch(s.ahead_edge);
   detail::prefetch(&version_[edge]);
 }
 
