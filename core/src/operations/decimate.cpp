@@ -297,7 +297,8 @@ class Decimator {
   }
 
   // ---- evaluation ----------------------------------------------------------------------
-  Vec3d local(Vertex v) const { return (to_double(m_.position(v)) - center_) * inv_scale_; }
+  Vec3d local(const Point& p) const { return (to_double(p) - center_) * inv_scale_; }
+  Vec3d local(Vertex v) const { return local(m_.position(v)); }
   Vec3d at(Vertex v) const { return to_double(vd_[v.idx()].position); }
   Point world(const Vec3d& p) const { return to_float(center_ + p * scale_); }
   // Shapes: the offset of v in shape k, and v's place there, in the normalized frame.
@@ -890,7 +891,6 @@ void Decimator::fetch_ahead(Scratch& s) const {
     Halfedge& x = s.ahead_ring[i];
     if (!x.is_valid()) continue;
     const Vertex w = m_.to_vertex(x);
-    detail::prefetch(&m_.position(w));
     detail::prefetch(&vd_[w.idx()]);
     detail::prefetch(&version_[Mesh::edge(x).idx()]);
     x = m_.ccw_rotated(x);
@@ -1177,9 +1177,10 @@ Decimator::Refusal Decimator::check(Halfedge h, const Point& target, Scratch& s,
   auto step = [&](Halfedge& x, Halfedge start, bool& more, std::vector<RingEntry>& ring) {
     const Vertex w = m_.to_vertex(x);
     if (region != kNoRegion && region_[w.idx()] != region) outside = true;
-    // The fold test below reads every neighbour's position: start those cache misses now,
-    // so they overlap the link test instead of following it one by one.
-    detail::prefetch(&m_.position(w));
+    // The fold test below reads every neighbour's place from its record (the one measuring
+    // the kept vertex's edges reads next, so the mesh's positions stay out of the loop):
+    // start those cache misses now, so they overlap the link test instead of following it.
+    detail::prefetch(&vd_[w.idx()]);
     ring.push_back({w, m_.face(x), Vec3d{}});
     x = m_.ccw_rotated(x);
     more = x != start;
@@ -1231,16 +1232,16 @@ Decimator::Refusal Decimator::check(Halfedge h, const Point& target, Scratch& s,
   // is judged over the whole neighbourhood (pmp's rule): a collapse may not make its worst
   // triangle worse than both the threshold and the worst triangle it replaces, so slivers of
   // the input do not freeze the regions around them.
-  const Vec3d p_new = to_double(target);
+  const Vec3d p_new = local(target);
   s.worst_new = s.worst_old = 1;
   if (opt_.min_quality > 0) {
-    const Vec3d p0 = to_double(m_.position(v0)), p1 = to_double(m_.position(v1));
-    if (vl.is_valid()) s.worst_old = std::min(s.worst_old, triangle_quality(p0, p1, to_double(m_.position(vl))));
-    if (vr.is_valid()) s.worst_old = std::min(s.worst_old, triangle_quality(p1, p0, to_double(m_.position(vr))));
+    const Vec3d p0 = at(v0), p1 = at(v1);
+    if (vl.is_valid()) s.worst_old = std::min(s.worst_old, triangle_quality(p0, p1, at(vl)));
+    if (vr.is_valid()) s.worst_old = std::min(s.worst_old, triangle_quality(p1, p0, at(vr)));
   }
   auto faces_ok = [&](Vertex v, std::vector<RingEntry>& ring) {
-    for (RingEntry& r : ring) r.position = to_double(m_.position(r.vertex));
-    const Vec3d apex = to_double(m_.position(v));
+    for (RingEntry& r : ring) r.position = at(r.vertex);
+    const Vec3d apex = at(v);
     const std::size_t n = ring.size();
     for (std::size_t i = 0; i < n; ++i) {
       const Face f = ring[i].face;
