@@ -565,13 +565,16 @@ void Decimator::compute_quadrics() {
     }
   });
   // Each vertex sums the planes of its own faces and boundary edges, around its ring: the
-  // same order, so the same bits, on any number of threads.
+  // same order, so the same bits, on any number of threads. The vertices are visited in the
+  // order of the faces, each from the face its outgoing half-edge (or, on the boundary, that
+  // half-edge's opposite) lies in: neighbouring faces lie near one another in the arrays
+  // more often than neighbouring vertices do (subdivision numbers every new vertex after
+  // the old ones), so the rings walked one after the other share what is in cache.
   std::atomic<bool> has_boundary{false};
-  parallel_for(n, opt_.threads, [&](std::size_t begin, std::size_t end) {
+  parallel_for(m_.faces_size(), opt_.threads, [&](std::size_t begin, std::size_t end) {
     bool boundary = false;
-    for (std::size_t i = begin; i < end; ++i) {
-      const Vertex v(static_cast<Index>(i));
-      if (m_.is_deleted(v) || !m_.halfedge(v).is_valid()) continue;
+    auto sum_planes = [&](Vertex v) {
+      const std::size_t i = v.idx();
       Quadric q = face_planes(v, [&](Vertex w) { return at(w); });
       // Counted here, while the ring face_planes() has just walked is still in cache.
       vd_[i].valence =
@@ -586,6 +589,15 @@ void Decimator::compute_quadrics() {
         Quadric qk = face_planes(v, [&](Vertex w) { return shape_at(k, w); });
         if (!weight_factor_.empty()) qk *= weight_factor_[i];
         shape_quadrics_[i * shapes_.size() + k].store(qk);
+      }
+    };
+    for (std::size_t j = begin; j < end; ++j) {
+      const Face f(static_cast<Index>(j));
+      if (m_.is_deleted(f)) continue;
+      for (Halfedge h : m_.halfedges(f)) {
+        if (const Vertex v = m_.from_vertex(h); m_.halfedge(v) == h) sum_planes(v);
+        const Halfedge o = Mesh::opposite(h);
+        if (const Vertex w = m_.to_vertex(h); m_.is_boundary(o) && m_.halfedge(w) == o) sum_planes(w);
       }
     }
     if (boundary) has_boundary.store(true, std::memory_order_relaxed);
