@@ -3,6 +3,7 @@
 #include "hedge/mesh.h"
 
 #include <algorithm>
+#include <cstring>
 
 #include "hedge/error.h"
 #include "hedge/limits.h"
@@ -280,9 +281,76 @@ void gather(Array& data, std::span<const Index> new_to_old, F f) {
 }
 }  // namespace
 
+namespace {
+// maps: old -> new for every old element, invalid for those not kept.
+void fill_maps(GarbageMaps& maps, std::span<const Index> vkeep, std::span<const Index> ekeep,
+               std::span<const Index> fkeep, std::size_t n_vertices, std::size_t n_edges, std::size_t n_faces) {
+  auto old_to_new = [](std::vector<Index>& map, std::size_t n, std::span<const Index> keep) {
+    map.assign(n, kInvalidIndex);
+    for (std::size_t i = 0; i < keep.size(); ++i) map[keep[i]] = static_cast<Index>(i);
+  };
+  old_to_new(maps.vertices, n_vertices, vkeep);
+  old_to_new(maps.edges, n_edges, ekeep);
+  old_to_new(maps.faces, n_faces, fkeep);
+}
+
+// Old -> new indices through maps over every old element.
+struct ThroughMaps {
+  const GarbageMaps& maps;
+  Index vertex(Index i) const { return maps.vertices[i]; }
+  Index edge(Index i) const { return maps.edges[i]; }
+  Index face(Index i) const { return maps.faces[i]; }
+};
+
+// Old -> new index of a live element when the live elements keep their order: the number
+// of live elements before it, from a count per 64 deletion marks and the marks themselves
+// (bytes of 0 or 1, summed eight at a time).
+class LiveRank {
+ public:
+  static constexpr std::size_t kBlock = 64;
+  explicit LiveRank(const std::vector<std::uint8_t>& deleted) : deleted_(deleted) {
+    if (deleted.empty()) return;
+    before_.resize(deleted.size() / kBlock + 1);
+    Index live = 0;
+    for (std::size_t b = 0; b < before_.size(); ++b) {
+      before_[b] = live;
+      const std::size_t begin = b * kBlock, end = std::min(begin + kBlock, deleted.size());
+      live += Index(end - begin) - deleted_between(begin, end);
+    }
+  }
+  Index operator()(Index old) const {
+    if (deleted_.empty()) return old;  // nothing of this kind was deleted
+    const std::size_t begin = old / kBlock * kBlock;
+    return before_[old / kBlock] + Index(old - begin) - deleted_between(begin, old);
+  }
+
+ private:
+  Index deleted_between(std::size_t begin, std::size_t end) const {
+    Index count = 0;
+    std::size_t i = begin;
+    for (; i + 8 <= end; i += 8) {
+      std::uint64_t word;
+      std::memcpy(&word, deleted_.data() + i, sizeof word);
+      count += Index((word * 0x0101010101010101ull) >> 56);
+    }
+    for (; i < end; ++i) count += deleted_[i];
+    return count;
+  }
+  const std::vector<std::uint8_t>& deleted_;
+  std::vector<Index> before_;
+};
+
+struct ByRank {
+  LiveRank vertices, edges, faces;
+  Index vertex(Index i) const { return vertices(i); }
+  Index edge(Index i) const { return edges(i); }
+  Index face(Index i) const { return faces(i); }
+};
+}  // namespace
+
 GarbageMaps Mesh::garbage_collect() {
+  GarbageMaps maps;
   if (!has_garbage()) {
-    GarbageMaps maps;
     auto identity = [](std::vector<Index>& map, std::size_t n) {
       map.resize(n);
       for (std::size_t i = 0; i < n; ++i) map[i] = static_cast<Index>(i);
@@ -292,9 +360,20 @@ GarbageMaps Mesh::garbage_collect() {
     identity(maps.faces, faces_size());
     return maps;
   }
-  return renumber(live_elements(vertices_size(), [&](Index i) { return is_deleted(Vertex(i)); }),
-                  live_elements(edges_size(), [&](Index i) { return is_deleted(Edge(i)); }),
-                  live_elements(faces_size(), [&](Index i) { return is_deleted(Face(i)); }));
+  const std::vector<Index> vkeep = live_elements(vertices_size(), [&](Index i) { return is_deleted(Vertex(i)); });
+  const std::vector<Index> ekeep = live_elements(edges_size(), [&](Index i) { return is_deleted(Edge(i)); });
+  const std::vector<Index> fkeep = live_elements(faces_size(), [&](Index i) { return is_deleted(Face(i)); });
+  fill_maps(maps, vkeep, ekeep, fkeep, vertices_size(), edges_size(), faces_size());
+  renumber(vkeep, ekeep, fkeep, ThroughMaps{maps});
+  return maps;
+}
+
+void Mesh::compact() {
+  if (!has_garbage()) return;
+  renumber(live_elements(vertices_size(), [&](Index i) { return is_deleted(Vertex(i)); }),
+           live_elements(edges_size(), [&](Index i) { return is_deleted(Edge(i)); }),
+           live_elements(faces_size(), [&](Index i) { return is_deleted(Face(i)); }),
+           ByRank{LiveRank(vdeleted_), LiveRank(edeleted_), LiveRank(fdeleted_)});
 }
 
 GarbageMaps Mesh::reorder(std::span<const Index> vertex_order, std::span<const Index> edge_order,
@@ -320,18 +399,15 @@ GarbageMaps Mesh::reorder(std::span<const Index> vertex_order, std::span<const I
       edge_order, edges_size(), n_edges(), [&](Index i) { return is_deleted(Edge(i)); }, "edges");
   check(
       face_order, faces_size(), n_faces(), [&](Index i) { return is_deleted(Face(i)); }, "faces");
-  return renumber(vertex_order, edge_order, face_order);
+  GarbageMaps maps;
+  fill_maps(maps, vertex_order, edge_order, face_order, vertices_size(), edges_size(), faces_size());
+  renumber(vertex_order, edge_order, face_order, ThroughMaps{maps});
+  return maps;
 }
 
-GarbageMaps Mesh::renumber(std::span<const Index> vkeep, std::span<const Index> ekeep, std::span<const Index> fkeep) {
-  GarbageMaps maps;
-  auto old_to_new = [](std::vector<Index>& map, std::size_t n, std::span<const Index> keep) {
-    map.assign(n, kInvalidIndex);
-    for (std::size_t i = 0; i < keep.size(); ++i) map[keep[i]] = static_cast<Index>(i);
-  };
-  old_to_new(maps.vertices, vertices_size(), vkeep);
-  old_to_new(maps.edges, edges_size(), ekeep);
-  old_to_new(maps.faces, faces_size(), fkeep);
+template <class Renumbered>
+void Mesh::renumber(std::span<const Index> vkeep, std::span<const Index> ekeep, std::span<const Index> fkeep,
+                    const Renumbered& renumbered) {
   std::vector<Index> hkeep;
   hkeep.reserve(2 * ekeep.size());
   for (Index e : ekeep) {
@@ -339,9 +415,12 @@ GarbageMaps Mesh::renumber(std::span<const Index> vkeep, std::span<const Index> 
     hkeep.push_back(2 * e + 1);
   }
 
-  auto map_h = [&](Halfedge h) { return h.is_valid() ? Halfedge(maps.halfedge(h.idx())) : h; };
-  auto map_v = [&](Vertex v) { return v.is_valid() ? Vertex(maps.vertices[v.idx()]) : v; };
-  auto map_f = [&](Face f) { return f.is_valid() ? Face(maps.faces[f.idx()]) : f; };
+  // Live elements refer only to live elements.
+  auto map_h = [&](Halfedge h) {
+    return h.is_valid() ? Halfedge(2 * renumbered.edge(h.idx() >> 1) + (h.idx() & 1)) : h;
+  };
+  auto map_v = [&](Vertex v) { return v.is_valid() ? Vertex(renumbered.vertex(v.idx())) : v; };
+  auto map_f = [&](Face f) { return f.is_valid() ? Face(renumbered.face(f.idx())) : f; };
 
   gather(vertex_halfedge_, vkeep, map_h);
   gather(positions_, vkeep, [](const Point& p) { return p; });
@@ -363,7 +442,6 @@ GarbageMaps Mesh::renumber(std::span<const Index> vkeep, std::span<const Index> 
   edeleted_.clear();
   fdeleted_.clear();
   deleted_ = {};
-  return maps;
 }
 
 std::size_t Mesh::heap_bytes() const {

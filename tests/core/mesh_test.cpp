@@ -229,6 +229,50 @@ TEST(Mesh, DeleteFaceAndGarbageCollect) {
   EXPECT_EQ(topology_stats(m).boundary_loops, 1u);
 }
 
+TEST(Mesh, CompactIsGarbageCollectWithoutMaps) {
+  // A grid large enough for several blocks of 64 deletion marks, with faces deleted in an
+  // irregular pattern (vertices, edges and faces all go, in runs and alone).
+  constexpr int n = 24;
+  Mesh m;
+  std::vector<Vertex> v;
+  for (int y = 0; y <= n; ++y)
+    for (int x = 0; x <= n; ++x) v.push_back(m.add_vertex(Point{{float(x), float(y), float(x * y % 7)}}));
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n; ++x)
+      m.add_quad(v[y * (n + 1) + x], v[y * (n + 1) + x + 1], v[(y + 1) * (n + 1) + x + 1], v[(y + 1) * (n + 1) + x]);
+  auto tag = m.add_vertex_property<int>("tag");
+  for (Vertex w : m.vertices()) tag[w] = int(w.idx()) * 3;
+  for (Face f : m.faces())
+    if ((f.idx() * 37) % 11 < 4 || (f.idx() > 100 && f.idx() < 180)) m.delete_face(f);
+  ASSERT_TRUE(m.has_garbage());
+  Mesh a = m, b = m;
+  a.garbage_collect();
+  b.compact();
+  // (Deleting faces may leave vertices pinched, which validate() names: the same in both.)
+  EXPECT_EQ(validate(b).message, validate(a).message);
+  EXPECT_FALSE(b.has_garbage());
+  ASSERT_EQ(b.vertices_size(), a.vertices_size());
+  ASSERT_EQ(b.edges_size(), a.edges_size());
+  ASSERT_EQ(b.faces_size(), a.faces_size());
+  for (Vertex w : a.vertices()) {
+    EXPECT_EQ(b.halfedge(w), a.halfedge(w));
+    EXPECT_EQ(b.position(w), a.position(w));
+    EXPECT_EQ(b.get_vertex_property<int>("tag")[w], a.get_vertex_property<int>("tag")[w]);
+  }
+  for (Face f : a.faces()) EXPECT_EQ(b.halfedge(f), a.halfedge(f));
+  for (Halfedge h : a.halfedges()) {
+    EXPECT_EQ(b.to_vertex(h), a.to_vertex(h));
+    EXPECT_EQ(b.face(h), a.face(h));
+    EXPECT_EQ(b.next(h), a.next(h));
+    EXPECT_EQ(b.prev(h), a.prev(h));
+  }
+  // Nothing deleted: nothing changes.
+  Mesh c = a;
+  c.compact();
+  EXPECT_EQ(c.vertices_size(), a.vertices_size());
+  EXPECT_EQ(c.halfedge(Vertex(5)), a.halfedge(Vertex(5)));
+}
+
 TEST(Mesh, ReorderRenumbersLiveElementsAndCarriesEverything) {
   Mesh m = quad_grid();
   auto tag = m.add_vertex_property<int>("tag");

@@ -360,6 +360,10 @@ class Mesh {
   void delete_vertex(Vertex v);
   //! Compacts the arrays, keeping the relative order of the live elements.
   GarbageMaps garbage_collect();
+  //! garbage_collect() without its maps, for callers that hold no indices: the maps span
+  //! every old element, and on a mesh that lost most of them writing them (fresh memory)
+  //! costs more than compacting what is left.
+  void compact();
   //! Renumbers the live elements: vertex_order[i] (an index now) becomes vertex i, and so
   //! for edges and faces; each order lists every live element once. Deleted elements go, as
   //! in garbage_collect(). For laying a mesh out in memory to suit an algorithm's walks
@@ -473,10 +477,12 @@ class Mesh {
     if (auto* a = c.get<T>(name)) return Property<H, T>(a);
     return Property<H, T>(c.add<T>(name, def));
   }
-  // garbage_collect() and reorder(): element i of each array becomes element i of the order
-  // given (new -> old).
-  GarbageMaps renumber(std::span<const Index> vertex_order, std::span<const Index> edge_order,
-                       std::span<const Index> face_order);
+  // garbage_collect(), compact() and reorder(): element i of each array becomes element i
+  // of the order given (new -> old); `renumbered` maps references (old -> new) through its
+  // vertex(), edge() and face(). Defined and used in mesh.cpp only.
+  template <class Renumbered>
+  void renumber(std::span<const Index> vertex_order, std::span<const Index> edge_order,
+                std::span<const Index> face_order, const Renumbered& renumbered);
   void mark_deleted(Vertex v, Deletions& tally);
   void mark_deleted(Edge e, Deletions& tally);
   void mark_deleted(Face f, Deletions& tally);

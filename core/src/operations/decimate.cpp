@@ -1582,7 +1582,7 @@ DecimateReport Decimator::run() {
     report_.faces_after = faces_;
     report_.vertices_after = m_.n_vertices();
     report_.stopped_by = "nothing to do";
-    if (report_.triangulated_faces) m_.garbage_collect();
+    if (report_.triangulated_faces) m_.compact();
     return report_;
   }
 
@@ -1681,7 +1681,7 @@ DecimateReport Decimator::run() {
 #endif
   m_.add_deletions(serial_.tally);
   progress_.update(0.95, "compacting");
-  m_.garbage_collect();
+  m_.compact();
   report_.faces_after = m_.n_faces();
   report_.vertices_after = m_.n_vertices();
   report_.max_error = std::sqrt(max_error_sq_seen_);

@@ -1101,7 +1101,7 @@ RemeshReport Remesher::run() {
   open_caps();
   progress_.update(0.98, "carrying attributes");
   resample_attributes();
-  mesh_.garbage_collect();
+  mesh_.compact();
   report_.output_faces = mesh_.n_faces();
   report_.output_vertices = mesh_.n_vertices();
   return report_;

@@ -571,7 +571,7 @@ RepairReport repair(Mesh& mesh, const RepairOptions& options, Progress& progress
         ++report.isolated_vertices_removed;
       }
   }
-  work.garbage_collect();
+  work.compact();
 
   say(report, report.vertices_welded,
       "welded " + plural(report.vertices_welded, "vertex", "vertices") + " into a neighbour at most " +

@@ -303,7 +303,7 @@ SubdivideReport subdivide(Mesh& mesh, const SubdivideOptions& options, Progress&
   const Mesh* current = &mesh;
   if (mesh.has_garbage()) {
     compacted = mesh;
-    compacted.garbage_collect();
+    compacted.compact();
     current = &compacted;
   }
   // Creases are found once, on the input; later steps carry them to the pieces of their edges.
