@@ -126,7 +126,7 @@ RegionPartitions::RegionPartitions(const Mesh& m, const Vec3d& center, double in
   // Cells: 64 per axis up to 2 million vertices, 128 above.
   const int bits = n <= (std::size_t(1) << 21) ? 6 : 7;
   const std::size_t n_cells = std::size_t(1) << (3 * bits);
-  std::vector<std::uint32_t> cell(n);
+  std::vector<std::uint32_t, UnsetAllocator<std::uint32_t>> cell(n);  // written whole on all threads
   std::vector<std::size_t> cell_start(n_cells + 1);
   std::vector<std::uint16_t> region_of_cell(n_cells);
   for (int grid = 0; grid < 2; ++grid) {
@@ -147,7 +147,7 @@ RegionPartitions::RegionPartitions(const Mesh& m, const Vec3d& center, double in
         std::size_t r = std::size_t(double((cell_start[c] + shift) * regions_) / double(n));
         region_of_cell[c] = std::uint16_t(r >= regions_ ? r - regions_ : r);
       }
-      std::vector<std::uint16_t>& map = maps_[2 * grid + shifted];
+      auto& map = maps_[2 * grid + shifted];
       map.resize(n);
       parallel_for(n, threads, [&](std::size_t begin, std::size_t end) {
         for (std::size_t i = begin; i < end; ++i) map[i] = region_of_cell[cell[i]];

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "hedge/detail/memory.h"
 #include "hedge/mesh.h"
 
 namespace hedge::detail {
@@ -53,14 +54,15 @@ class RegionPartitions {
   //! Covers one more vertex (vertex size()), putting it in vertex `like`'s regions: a vertex
   //! added to a mesh in the middle of an edge goes where one of its ends is.
   void append_like(std::size_t like) {
-    for (std::vector<std::uint16_t>& map : maps_) map.push_back(map[like]);
+    for (auto& map : maps_) map.push_back(map[like]);
   }
   //! Phase k's map from a vertex to its region.
   const std::uint16_t* phase(int k) const { return maps_[2 * (k % 2) + (k % 4 >= 2)].data(); }
 
  private:
   std::size_t regions_ = 0;
-  std::vector<std::uint16_t> maps_[4];
+  // Left unset by resize(): each is written whole on all threads, which share the first touch.
+  std::vector<std::uint16_t, UnsetAllocator<std::uint16_t>> maps_[4];
 };
 
 }  // namespace hedge::detail

@@ -486,12 +486,14 @@ class Decimator {
   void collapse_in_regions();
   std::size_t collapse_phase();
   void collapse_region(Worker& w);
-  std::vector<float> cost_;  // per edge during the phases; kNoCost: no candidate
+  // Per edge during the phases; kNoCost: no candidate. Like live_edges_, left unset by
+  // resize() and written whole on all threads, which share the first touch of its pages.
+  std::vector<float, detail::UnsetAllocator<float>> cost_;
   // The partitions into regions, and the phase's map from a vertex to its region.
   detail::RegionPartitions partitions_;
   const std::uint16_t* region_ = nullptr;
-  std::vector<Index> live_edges_;  // in order; those deleted are dropped at each phase
-  std::vector<Worker> workers_;    // one per region
+  std::vector<Index, detail::UnsetAllocator<Index>> live_edges_;  // in order; those deleted are dropped at each phase
+  std::vector<Worker> workers_;                                   // one per region
   std::size_t regions_ = 0;
   struct Queued {
     std::uint32_t key;
@@ -966,7 +968,9 @@ void Decimator::collapse_in_regions() {
                                          opt_.threads);
   regions_ = partitions_.regions();
   live_edges_.resize(m_.edges_size());
-  for (std::size_t i = 0; i < live_edges_.size(); ++i) live_edges_[i] = Index(i);
+  parallel_for(live_edges_.size(), opt_.threads, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) live_edges_[i] = Index(i);
+  });
   workers_.clear();
   for (std::size_t r = 0; r < regions_; ++r) workers_.emplace_back(&version_).region = std::uint16_t(r);
 
