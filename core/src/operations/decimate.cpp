@@ -248,8 +248,10 @@ constexpr double kMaxWeightStrength = 1000;
 constexpr double kPull = 0.01;
 
 // Collapsing in regions (Decimator::collapse_in_regions): from this many faces on, while
-// more than kTailShare of the faces to remove are left (and at least kMinPhase collapses'
-// worth).
+// more than kTailShare of the faces to remove, and of the target, are left (and at least
+// kMinPhase collapses' worth). A phase's passes cost in proportion to the mesh left, the
+// serial tail in proportion to its own collapses: past a small share of the target, another
+// phase is cheaper than leaving its collapses to the tail.
 constexpr std::size_t kRegionsMinFaces = 50000;
 constexpr std::size_t kRegionVertices = 16384;  // about this many vertices per region, in at least
 constexpr std::size_t kMinRegions = 32;         // this many regions
@@ -977,7 +979,7 @@ void Decimator::collapse_in_regions() {
   // The grids alternate, and each grid's runs shift every other time, so that edges near
   // one phase's borders lie inside the next phase's regions.
   const std::size_t start_faces = faces_, to_remove = faces_ - target_;
-  const std::size_t tail = std::max(kMinPhase, std::size_t(kTailShare * double(to_remove)));
+  const std::size_t tail = std::max(kMinPhase, std::size_t(kTailShare * double(std::min(to_remove, target_))));
   for (int phase = 0; faces_ - target_ > tail; ++phase) {
     region_ = partitions_.phase(phase);
     const std::size_t made = collapse_phase();
