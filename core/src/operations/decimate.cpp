@@ -49,6 +49,13 @@ struct Quadric {
     k += w * s * s;
     weight += w;
   }
+  //! Plane m.u = 0 through the origin, given by a multiple m of its unit normal: adds
+  //! f m m^T, with f = w / |m|^2 for the plane's weight w.
+  void add_plane_through_origin(const Vec3d& m, double f, double w) {
+    a00 += f * m[0] * m[0], a01 += f * m[0] * m[1], a02 += f * m[0] * m[2];
+    a11 += f * m[1] * m[1], a12 += f * m[1] * m[2], a22 += f * m[2] * m[2];
+    weight += w;
+  }
   Quadric& operator+=(const Quadric& q) {
     a00 += q.a00, a01 += q.a01, a02 += q.a02, a11 += q.a11, a12 += q.a12, a22 += q.a22;
     g0 += q.g0, g1 += q.g1, g2 += q.g2, k += q.k, weight += q.weight;
@@ -275,8 +282,13 @@ class Decimator {
   void read_weights_and_locks();
   void find_shapes();
   void compute_quadrics();
+  // What face_planes() met going round a vertex.
+  struct RingSeen {
+    std::size_t valence = 0;
+    bool hole = false;  // a gap between two of its faces: the vertex is on the boundary
+  };
   template <class Where>
-  Quadric face_planes(Vertex v, Where where) const;
+  Quadric face_planes(Vertex v, Where where, RingSeen* seen = nullptr) const;
   bool add_boundary_planes(Vertex v, Quadric& q) const;
   void find_corner_channels();
   void classify_vertices();
@@ -579,11 +591,12 @@ void Decimator::compute_quadrics() {
     bool boundary = false;
     auto sum_planes = [&](Vertex v) {
       const std::size_t i = v.idx();
-      Quadric q = face_planes(v, [&](Vertex w) { return at(w); });
-      // Counted here, while the ring face_planes() has just walked is still in cache.
+      RingSeen seen;
+      Quadric q = face_planes(
+          v, [&](Vertex w) { return at(w); }, &seen);
       vd_[i].valence =
-          static_cast<std::uint16_t>(std::min<std::size_t>(m_.valence(v), std::numeric_limits<std::uint16_t>::max()));
-      boundary |= add_boundary_planes(v, q);
+          static_cast<std::uint16_t>(std::min<std::size_t>(seen.valence, std::numeric_limits<std::uint16_t>::max()));
+      if (seen.hole) boundary |= add_boundary_planes(v, q);
       // A weight scales every plane of the vertex, and so its share of a merged quadric: the
       // cost rises where detail matters while cost / weight stays a mean squared distance.
       if (!weight_factor_.empty()) q *= weight_factor_[i];
@@ -610,22 +623,27 @@ void Decimator::compute_quadrics() {
 }
 
 // The planes of v's faces weighted by area, so that a region's error does not depend on how
-// finely it happens to be tessellated, about v's own place (where(v)). Each face's plane
-// comes from its corners in its own order, the same bits for each of its vertices.
+// finely it happens to be tessellated, about v's own place (where(v)), which lies on all of
+// them. Each face's plane comes from its corners in its own order, the same bits for each
+// of its vertices.
 template <class Where>
-Quadric Decimator::face_planes(Vertex v, Where where) const {
+Quadric Decimator::face_planes(Vertex v, Where where, RingSeen* seen) const {
   Quadric q;
-  const Vec3d pv = where(v);
   for (Halfedge x : m_.outgoing(v)) {
+    if (seen) ++seen->valence;
     const Face f = m_.face(x);
-    if (!f.is_valid()) continue;
+    if (!f.is_valid()) {
+      if (seen) seen->hole = true;
+      continue;
+    }
     const Halfedge h = m_.halfedge(f);
     const Vec3d pa = where(m_.to_vertex(h)), pb = where(m_.to_vertex(m_.next(h))), pc = where(m_.to_vertex(m_.prev(h)));
-    Vec3d normal = cross(pb - pa, pc - pa);
-    const double len = norm(normal);
+    const Vec3d doubled_area = cross(pb - pa, pc - pa);  // along the normal
+    const double len = norm(doubled_area);
     if (!(len > 0)) continue;
-    normal /= len;
-    q.add_plane(normal, dot(normal, pv - pa), 0.5 * len);
+    // v is a corner, so its own faces' planes pass through it: no offset. Weighted by the
+    // area (len / 2), the unit normal's n n^T is doubled_area doubled_area^T / len^2.
+    q.add_plane_through_origin(doubled_area, 0.5 / len, 0.5 * len);
   }
   return q;
 }
