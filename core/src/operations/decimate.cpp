@@ -506,6 +506,11 @@ class Decimator {
   // The partitions into regions, and the phase's map from a vertex to its region.
   detail::RegionPartitions partitions_;
   const std::uint16_t* region_ = nullptr;
+  // Per vertex during a phase: 1 when a neighbour lies in another region. Only edges with
+  // neither end on a border are queued: any other would be refused (its rings leave the
+  // region). Within a phase no vertex leaves or joins a border: a collapse gives the kept
+  // vertex only neighbours of the removed one, and regions never collapse a border vertex.
+  std::vector<std::uint8_t> border_;
   std::vector<Index, detail::UnsetAllocator<Index>> live_edges_;  // in order; those deleted are dropped at each phase
   std::vector<Worker> workers_;                                   // one per region
   std::size_t regions_ = 0;
@@ -968,7 +973,9 @@ void Decimator::requeue(Edge e, Worker& w) {
   const std::uint8_t v = ++version_[e.idx()];
   const float cost = measure(e);
   if (!cost_.empty()) cost_[e.idx()] = cost;
-  if (cost != kNoCost && cost <= w.max_cost) w.queue.push(EdgeQueue::key(cost, v), e.idx());
+  if (cost == kNoCost || cost > w.max_cost) return;
+  if (w.region != kNoRegion && (border_[m_.vertex(e, 0).idx()] || border_[m_.vertex(e, 1).idx()])) return;
+  w.queue.push(EdgeQueue::key(cost, v), e.idx());
 }
 
 namespace {
@@ -1007,6 +1014,7 @@ void Decimator::collapse_in_regions() {
   workers_.clear();
   partitions_ = {};
   region_ = nullptr;
+  border_ = {};
   live_edges_ = {};
   phase_lists_ = {};
   phase_histograms_ = {};
@@ -1028,16 +1036,21 @@ std::size_t Decimator::collapse_phase() {
         },
         1);
   };
+  // The region of an edge with neither end on a border; kNoRegion for the others.
   auto region_of = [&](std::size_t i) -> std::uint16_t {
     const Edge e(static_cast<Index>(i));
-    const std::uint16_t r = region_[m_.vertex(e, 0).idx()];
-    return r == region_[m_.vertex(e, 1).idx()] ? r : kNoRegion;
+    const Index a = m_.vertex(e, 0).idx(), b = m_.vertex(e, 1).idx();
+    return border_[a] || border_[b] ? kNoRegion : region_[a];
   };
   constexpr int kShift = 16;
   constexpr std::size_t kBuckets = std::size_t(1) << (32 - kShift);
   std::vector<std::uint32_t>& histograms = phase_histograms_;
   histograms.assign(n_parts * kBuckets, 0);
   std::vector<std::size_t> part_live(n_parts);
+  border_.resize(m_.vertices_size());
+  parallel_for(border_.size(), opt_.threads, [&](std::size_t begin, std::size_t end) {
+    std::fill(border_.begin() + std::ptrdiff_t(begin), border_.begin() + std::ptrdiff_t(end), 0);
+  });
   for_each_part([&](std::size_t k, std::size_t begin, std::size_t end) {
     std::uint32_t* histogram = histograms.data() + k * kBuckets;
     std::size_t live = begin;
@@ -1046,6 +1059,12 @@ std::size_t Decimator::collapse_phase() {
       if (m_.is_deleted(Edge(i))) continue;
       live_edges_[live++] = i;
       if (cost_[i] != kNoCost) ++histogram[cost_bits(cost_[i]) >> kShift];
+      const Index a = m_.vertex(Edge(i), 0).idx(), b = m_.vertex(Edge(i), 1).idx();
+      if (region_[a] != region_[b]) {
+        // Both parts may mark one vertex: the same byte, stored atomically.
+        std::atomic_ref<std::uint8_t>(border_[a]).store(1, std::memory_order_relaxed);
+        std::atomic_ref<std::uint8_t>(border_[b]).store(1, std::memory_order_relaxed);
+      }
     }
     part_live[k] = live - begin;
   });
