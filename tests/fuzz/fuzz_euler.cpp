@@ -296,6 +296,20 @@ class DefectRule {
   std::size_t subdivisions_ = 0;
 };
 
+// Same arrays: sizes, connectivity and positions.
+bool same_elements(const Mesh& a, const Mesh& b) {
+  if (a.vertices_size() != b.vertices_size() || a.edges_size() != b.edges_size() || a.faces_size() != b.faces_size())
+    return false;
+  for (hedge::Vertex v : a.vertices())
+    if (a.halfedge(v) != b.halfedge(v) || a.position(v) != b.position(v)) return false;
+  for (hedge::Face f : a.faces())
+    if (a.halfedge(f) != b.halfedge(f)) return false;
+  for (hedge::Halfedge h : a.halfedges())
+    if (a.to_vertex(h) != b.to_vertex(h) || a.face(h) != b.face(h) || a.next(h) != b.next(h) || a.prev(h) != b.prev(h))
+      return false;
+  return true;
+}
+
 void check(DefectRule& rule, const Mesh& mesh, const char* after) {
   validated(mesh, after);
   rule.euler(mesh, after);
@@ -547,10 +561,15 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
           check(rule, mesh, "remove_isolated_vertex");
         }
         break;
-      case 12:
+      case 12: {
+        // compact() must leave what garbage_collect() leaves.
+        Mesh compacted = mesh;
+        compacted.compact();
         mesh.garbage_collect();
         check(rule, mesh, "garbage_collect");
+        if (!same_elements(mesh, compacted)) hedge_fuzz::fail("compact() and garbage_collect() disagree");
         break;
+      }
       default:
         if (mesh.n_faces() <= max_faces) run_catalogue(in, mesh, rule);
         break;
