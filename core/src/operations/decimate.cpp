@@ -332,11 +332,14 @@ class Decimator {
       if (std::memcmp(c->element(a.idx()), c->element(b.idx()), c->stride()) != 0) return false;
     return true;
   }
+  // kPlace: also where the new vertex goes and how its attributes blend (c.position,
+  // c.kept_weight, c.side); without it only c.cost is set, which is all the queue needs.
+  template <bool kPlace = true>
   bool evaluate(Edge e, Candidate& c) const;
   // The cost of e's best collapse; kNoCost when it has none (or is deleted).
   float measure(Edge e) const {
     Candidate c;
-    return !m_.is_deleted(e) && evaluate(e, c) ? c.cost : kNoCost;
+    return !m_.is_deleted(e) && evaluate<false>(e, c) ? c.cost : kNoCost;
   }
   double boundary_shift(Halfedge h0, const Vec3d& p) const;
   struct Scratch;
@@ -802,6 +805,7 @@ double Decimator::boundary_shift(Halfedge h0, const Vec3d& p) const {
 // The cheapest legal placement for collapsing e. Which end may go and which may move
 // follows from the boundary and seam rules; the position is the quadric's minimum when
 // both ends are free, else the best point of the edge, else the fixed end.
+template <bool kPlace>
 bool Decimator::evaluate(Edge e, Candidate& c) const {
   const Halfedge h0 = Mesh::halfedge(e, 0);
   const Halfedge o0 = Mesh::opposite(h0);
@@ -853,7 +857,7 @@ bool Decimator::evaluate(Edge e, Candidate& c) const {
       // such a point is a numerical accident, not a better surface.
       found = sqrnorm(p - ab * 0.5) <= 4 * dd;
     }
-    double t;  // along the edge from the removed vertex, for attribute interpolation
+    double t = 0.5;  // along the edge from the removed vertex, for attribute interpolation
     double cost;
     if (!found) {
       const double curvature = dot(d, q.times(d));
@@ -862,15 +866,17 @@ bool Decimator::evaluate(Edge e, Candidate& c) const {
       p = from + d * t;
       cost = q(p);
     } else {
-      t = dd > 0 ? std::clamp(dot(p - from, d) / dd, 0.0, 1.0) : 0.5;
+      if (kPlace || !shapes_.empty()) t = dd > 0 ? std::clamp(dot(p - from, d) / dd, 0.0, 1.0) : 0.5;
       cost = q(p);
     }
     if (touches_boundary) cost += boundary_weight * boundary_shift(h0, pa + p);
     if (!shapes_.empty()) cost += shapes_cost(a, b, p, remove_a ? t : 1 - t);
-    c.position = world(pa + p);
     c.cost = static_cast<float>(cost);
-    c.kept_weight = static_cast<float>(t);
-    c.side = remove_a ? 0 : 1;
+    if constexpr (kPlace) {
+      c.position = world(pa + p);
+      c.kept_weight = static_cast<float>(t);
+      c.side = remove_a ? 0 : 1;
+    }
     return true;
   }
   // One end stays where it is.
@@ -885,10 +891,12 @@ bool Decimator::evaluate(Edge e, Candidate& c) const {
     if (rb) cost_keep_a += shapes_cost(a, b, Vec3d{}, 0);
   }
   const bool keep_b = cost_keep_b <= cost_keep_a;
-  c.position = m_.position(keep_b ? b : a);
   c.cost = static_cast<float>(keep_b ? cost_keep_b : cost_keep_a);
-  c.kept_weight = 1;
-  c.side = keep_b ? 0 : 1;
+  if constexpr (kPlace) {
+    c.position = m_.position(keep_b ? b : a);
+    c.kept_weight = 1;
+    c.side = keep_b ? 0 : 1;
+  }
   return true;
 }
 
