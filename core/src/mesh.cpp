@@ -279,9 +279,16 @@ void gather(Array& data, std::span<const Index> new_to_old, F f) {
   });
   data.swap(out);
 }
-}  // namespace
 
-namespace {
+// The live vertices, edges and faces of m, each in index order.
+struct LiveElements {
+  std::vector<Index> vertices, edges, faces;
+  explicit LiveElements(const Mesh& m)
+      : vertices(live_elements(m.vertices_size(), [&](Index i) { return m.is_deleted(Vertex(i)); })),
+        edges(live_elements(m.edges_size(), [&](Index i) { return m.is_deleted(Edge(i)); })),
+        faces(live_elements(m.faces_size(), [&](Index i) { return m.is_deleted(Face(i)); })) {}
+};
+
 // maps: old -> new for every old element, invalid for those not kept.
 void fill_maps(GarbageMaps& maps, std::span<const Index> vkeep, std::span<const Index> ekeep,
                std::span<const Index> fkeep, std::size_t n_vertices, std::size_t n_edges, std::size_t n_faces) {
@@ -360,19 +367,16 @@ GarbageMaps Mesh::garbage_collect() {
     identity(maps.faces, faces_size());
     return maps;
   }
-  const std::vector<Index> vkeep = live_elements(vertices_size(), [&](Index i) { return is_deleted(Vertex(i)); });
-  const std::vector<Index> ekeep = live_elements(edges_size(), [&](Index i) { return is_deleted(Edge(i)); });
-  const std::vector<Index> fkeep = live_elements(faces_size(), [&](Index i) { return is_deleted(Face(i)); });
-  fill_maps(maps, vkeep, ekeep, fkeep, vertices_size(), edges_size(), faces_size());
-  renumber(vkeep, ekeep, fkeep, ThroughMaps{maps});
+  const LiveElements live(*this);
+  fill_maps(maps, live.vertices, live.edges, live.faces, vertices_size(), edges_size(), faces_size());
+  renumber(live.vertices, live.edges, live.faces, ThroughMaps{maps});
   return maps;
 }
 
 void Mesh::compact() {
   if (!has_garbage()) return;
-  renumber(live_elements(vertices_size(), [&](Index i) { return is_deleted(Vertex(i)); }),
-           live_elements(edges_size(), [&](Index i) { return is_deleted(Edge(i)); }),
-           live_elements(faces_size(), [&](Index i) { return is_deleted(Face(i)); }),
+  const LiveElements live(*this);
+  renumber(live.vertices, live.edges, live.faces,
            ByRank{LiveRank(vdeleted_), LiveRank(edeleted_), LiveRank(fdeleted_)});
 }
 
