@@ -1290,21 +1290,6 @@ void expect_selection_contract(const Mesh& before, const Mesh& after, const Subd
   }
 }
 
-//! Everything selected is the run without selection_only, element for element and bit for bit.
-void expect_same_mesh(const Mesh& a, const Mesh& b) {
-  ASSERT_EQ(a.vertices_size(), b.vertices_size());
-  ASSERT_EQ(a.edges_size(), b.edges_size());
-  ASSERT_EQ(a.faces_size(), b.faces_size());
-  EXPECT_EQ(std::memcmp(a.positions().data(), b.positions().data(), sizeof(Point) * a.positions().size()), 0);
-  for (Halfedge h : a.halfedges()) {
-    ASSERT_EQ(a.to_vertex(h), b.to_vertex(h)) << "half-edge " << h.idx();
-    ASSERT_EQ(a.next(h), b.next(h)) << "half-edge " << h.idx();
-    ASSERT_EQ(a.face(h), b.face(h)) << "half-edge " << h.idx();
-  }
-  for (Face f : a.faces()) ASSERT_EQ(a.halfedge(f), b.halfedge(f));
-  for (Vertex v : a.vertices()) ASSERT_EQ(a.halfedge(v), b.halfedge(v));
-}
-
 const std::vector<SubdivisionScheme> kAllSchemes = {SubdivisionScheme::loop, SubdivisionScheme::catmull_clark,
                                                     SubdivisionScheme::sqrt3, SubdivisionScheme::midpoint};
 const std::vector<SubdivisionScheme> kPolygonSchemes = {SubdivisionScheme::catmull_clark, SubdivisionScheme::midpoint};
@@ -1359,7 +1344,7 @@ TEST(SubdivideSelection, EverythingSelectedIsTheWholeRun) {
         Mesh whole = input, selected = input;
         subdivide(whole, scheme(s, iterations));
         subdivide(selected, selection_only(s, iterations));
-        expect_same_mesh(selected, whole);
+        test::expect_same_elements(selected, whole);
         EXPECT_EQ(subdivided_face_count(input, selection_only(s, iterations)), whole.n_faces());
       }
   }
@@ -1528,7 +1513,7 @@ TEST(SubdivideSelection, NothingSelectedChangesNothing) {
     if (with_channel) select_faces(mesh, [](const Vec3d&) { return false; });
     const Mesh before = mesh;
     const SubdivideReport r = subdivide(mesh, selection_only(SubdivisionScheme::loop, 2));
-    expect_same_mesh(mesh, before);
+    test::expect_same_elements(mesh, before);
     EXPECT_EQ(r.faces, 6u);
     EXPECT_EQ(r.faces_before, 6u);
     EXPECT_EQ(subdivided_face_count(before, selection_only(SubdivisionScheme::loop, 2)), 6u);
@@ -1661,7 +1646,7 @@ TEST(SubdivideSelection, SameResultAtEveryThreadCount) {
         continue;
       }
       SCOPED_TRACE(subdivision_scheme_name(s));
-      expect_same_mesh(mesh, reference);
+      test::expect_same_elements(mesh, reference);
     }
   }
 }

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <map>
 #include <utility>
 #include <vector>
@@ -25,6 +26,23 @@
   } while (0)
 
 namespace hedge::test {
+
+//! The same arrays element for element and bit for bit: sizes, positions, every half-edge's
+//! vertex, face, next and prev, and every vertex's and face's half-edge.
+inline void expect_same_elements(const Mesh& a, const Mesh& b) {
+  ASSERT_EQ(a.vertices_size(), b.vertices_size());
+  ASSERT_EQ(a.edges_size(), b.edges_size());
+  ASSERT_EQ(a.faces_size(), b.faces_size());
+  EXPECT_EQ(std::memcmp(a.positions().data(), b.positions().data(), sizeof(Point) * a.positions().size()), 0);
+  for (Halfedge h : a.halfedges()) {
+    ASSERT_EQ(a.to_vertex(h), b.to_vertex(h)) << "half-edge " << h.idx();
+    ASSERT_EQ(a.next(h), b.next(h)) << "half-edge " << h.idx();
+    ASSERT_EQ(a.prev(h), b.prev(h)) << "half-edge " << h.idx();
+    ASSERT_EQ(a.face(h), b.face(h)) << "half-edge " << h.idx();
+  }
+  for (Face f : a.faces()) ASSERT_EQ(a.halfedge(f), b.halfedge(f));
+  for (Vertex v : a.vertices()) ASSERT_EQ(a.halfedge(v), b.halfedge(v));
+}
 
 //! A manifold mesh from points and counter-clockwise faces; corner 0 of a face is the target
 //! of halfedge(f), and boundary loops are linked. The faces must form a manifold surface.
