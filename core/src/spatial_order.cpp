@@ -2,6 +2,7 @@
 #include "spatial_order.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -11,15 +12,14 @@
 namespace hedge::detail {
 
 namespace {
-// The low 10 bits of x, spread to every third bit.
-std::uint32_t spread_bits(std::uint32_t x) {
-  x &= 0x3ff;
-  x = (x | (x << 16)) & 0x030000ff;
-  x = (x | (x << 8)) & 0x0300f00f;
-  x = (x | (x << 4)) & 0x030c30c3;
-  x = (x | (x << 2)) & 0x09249249;
-  return x;
-}
+// Each 10-bit number with its bits spread to every third bit: one load instead of ten
+// shifts and masks, in the loops over every vertex.
+constexpr std::array<std::uint32_t, 1024> kSpreadBits = [] {
+  std::array<std::uint32_t, 1024> table{};
+  for (std::uint32_t x = 0; x < table.size(); ++x)
+    for (int bit = 0; bit < 10; ++bit) table[x] |= ((x >> bit) & 1u) << (3 * bit);
+  return table;
+}();
 
 // Sorts (code << 32 | index) pairs by their codes of 3 * kBits bits, stably: a radix sort,
 // kBits a pass, over the pairs themselves (no lookups of the codes through the indices).
@@ -53,14 +53,15 @@ std::vector<Index> order_by_bucket(std::size_t n, std::size_t live, std::size_t 
 }  // namespace
 
 std::uint32_t morton_cell(const Vec3f& p, double offset, int bits) {
+  const int last = (1 << bits) - 1;
+  const double cells = double(1 << bits);
   std::uint32_t code = 0;
   for (int axis = 0; axis < 3; ++axis) {
     double x = double(p[axis]) + 0.5 + offset;
     if (!(std::abs(x) < 1e9)) x = 0;         // not finite, or far out of the frame: any cell serves
     x -= double(static_cast<long long>(x));  // wrapped into [0, 1) (towards zero, then up)
     if (x < 0) x += 1;
-    const int q = std::clamp(int(x * (1 << bits)), 0, (1 << bits) - 1);
-    code |= spread_bits(std::uint32_t(q)) << axis;
+    code |= kSpreadBits[std::size_t(std::clamp(int(x * cells), 0, last))] << axis;
   }
   return code;
 }
