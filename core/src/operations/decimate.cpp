@@ -123,6 +123,25 @@ struct PackedQuadric {
   }
 };
 
+// The quadric of an edge's two ends about a's place, a and b stored about their own places
+// and b at ab from a: what unpack() + unpack().shifted(-ab) gives, the same operations in
+// the same order, written out so that no intermediate quadric goes through memory.
+inline Quadric merged_about_first(const PackedQuadric& a, const PackedQuadric& b, const Vec3d& ab) {
+  const double d0 = -ab[0], d1 = -ab[1], d2 = -ab[2];
+  const double b00 = b.a00, b01 = b.a01, b02 = b.a02, b11 = b.a11, b12 = b.a12, b22 = b.a22;
+  const double bg0 = b.g0, bg1 = b.g1, bg2 = b.g2;
+  const double ad0 = b00 * d0 + b01 * d1 + b02 * d2, ad1 = b01 * d0 + b11 * d1 + b12 * d2,
+               ad2 = b02 * d0 + b12 * d1 + b22 * d2;
+  const double bk = (0.0 + d0 * ad0 + d1 * ad1 + d2 * ad2) + 2 * (0.0 + d0 * bg0 + d1 * bg1 + d2 * bg2) + double(b.k);
+  Quadric q;
+  q.a00 = double(a.a00) + b00, q.a01 = double(a.a01) + b01, q.a02 = double(a.a02) + b02;
+  q.a11 = double(a.a11) + b11, q.a12 = double(a.a12) + b12, q.a22 = double(a.a22) + b22;
+  q.g0 = double(a.g0) + (bg0 + ad0), q.g1 = double(a.g1) + (bg1 + ad1), q.g2 = double(a.g2) + (bg2 + ad2);
+  q.k = double(a.k) + bk;
+  q.weight = double(a.weight) + double(b.weight);
+  return q;
+}
+
 // The queue of edges by cost: a radix heap (Ahuja, Mehlhorn, Orlin & Tarjan 1990) over the
 // bit patterns of the float costs (non-negative floats order like their bits). It needs
 // keys that never drop below the last one taken, which quadrics nearly guarantee: merging
@@ -810,9 +829,10 @@ bool Decimator::evaluate(Edge e, Candidate& c) const {
   const Halfedge h0 = Mesh::halfedge(e, 0);
   const Halfedge o0 = Mesh::opposite(h0);
   const Vertex b = m_.to_vertex(h0), a = m_.to_vertex(o0);  // h0 runs a -> b
-  const bool boundary_edge = m_.is_boundary(h0) || m_.is_boundary(o0);
   const VertexData &da = vd_[a.idx()], &db = vd_[b.idx()];
   const std::uint8_t fa = da.flags, fb = db.flags;
+  // Both ends of a boundary edge are on the boundary: only then are its faces read.
+  const bool boundary_edge = (fa & fb & kBoundary) && (m_.is_boundary(h0) || m_.is_boundary(o0));
 
   bool seam = false, seam_both = false;
   if (seam_mode_ && !boundary_edge && ((fa | fb) & kOnSeam)) {
@@ -832,15 +852,17 @@ bool Decimator::evaluate(Edge e, Candidate& c) const {
     if (f & kSeamLine) return seam_both;
     return true;
   };
-  const bool ra = removable(fa), rb = removable(fb);
+  // Most edges have neither end on a boundary, a seam or a lock: both ends free.
+  const bool plain = (fa | fb) == 0;
+  const bool ra = plain || removable(fa), rb = plain || removable(fb);
   if (!ra && !rb) return false;
-  const bool ma = movable(fa), mb = movable(fb);
+  const bool ma = plain || movable(fa), mb = plain || movable(fb);
   const bool touches_boundary = boundary_edge || ((fa | fb) & kBoundary);
 
   // Everything relative to a: both quadrics about a, a at the origin, b at ab.
   const Vec3d pa = to_double(da.position), pb = to_double(db.position);
   const Vec3d ab = pb - pa;
-  const Quadric q = da.quadric.unpack() + db.quadric.unpack().shifted(-ab);
+  const Quadric q = merged_about_first(da.quadric, db.quadric, ab);
   const double boundary_weight = kBoundaryWeight * sqrnorm(ab);
   if ((ra && mb) || (rb && ma)) {
     // Both ends free: the removed vertex is whichever may go (a when both may).
