@@ -889,7 +889,11 @@ bool Decimator::evaluate(Edge e, Candidate& c) const {
       cost = q(p);
     } else {
       if (kPlace || !shapes_.empty()) t = dd > 0 ? std::clamp(dot(p - from, d) / dd, 0.0, 1.0) : 0.5;
-      cost = q(p);
+      // p solves (A + lambda I) p = lambda c - g, so A p = lambda (c - p) - g and the
+      // quadric there is g.p + lambda p.(c - p) + k, without a product by A.
+      const Vec3d center = ab * 0.5;
+      const double lambda = kPull * (q.a00 + q.a11 + q.a22) / 3;
+      cost = std::max(0.0, dot(q.linear(), p) + lambda * dot(p, center - p) + q.k);
     }
     if (touches_boundary) cost += boundary_weight * boundary_shift(h0, pa + p);
     if (!shapes_.empty()) cost += shapes_cost(a, b, p, remove_a ? t : 1 - t);
