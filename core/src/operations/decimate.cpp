@@ -82,7 +82,7 @@ struct Quadric {
   //! ones by more than that fraction.
   Quadric pulled_towards(const Vec3d& center, double strength) const {
     Quadric q = *this;
-    const double lambda = strength * (a00 + a11 + a22) / 3;
+    const double lambda = strength / 3 * (a00 + a11 + a22);  // strength / 3 folds: no division
     q.a00 += lambda, q.a11 += lambda, q.a22 += lambda;
     q.g0 -= lambda * center[0], q.g1 -= lambda * center[1], q.g2 -= lambda * center[2];
     q.k += lambda * sqrnorm(center);
@@ -892,7 +892,7 @@ bool Decimator::evaluate(Edge e, Candidate& c) const {
       // p solves (A + lambda I) p = lambda c - g, so A p = lambda (c - p) - g and the
       // quadric there is g.p + lambda p.(c - p) + k, without a product by A.
       const Vec3d center = ab * 0.5;
-      const double lambda = kPull * (q.a00 + q.a11 + q.a22) / 3;
+      const double lambda = kPull / 3 * (q.a00 + q.a11 + q.a22);
       cost = std::max(0.0, dot(q.linear(), p) + lambda * dot(p, center - p) + q.k);
     }
     if (touches_boundary) cost += boundary_weight * boundary_shift(h0, pa + p);
