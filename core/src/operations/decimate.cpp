@@ -10,6 +10,7 @@
 #include <limits>
 #include <memory>
 #include <numbers>
+#include <numeric>
 #include <optional>
 #include <vector>
 
@@ -542,6 +543,7 @@ class Decimator {
   };
   std::vector<std::vector<Queued>> phase_lists_;  // per part and region: the edges to queue
   std::vector<std::uint32_t> phase_histograms_;   // per part: the costs' top bits
+  std::vector<std::uint16_t> phase_order_;        // the regions, largest queue first
 
   std::size_t faces_ = 0;
   std::size_t target_ = 0;
@@ -1052,6 +1054,7 @@ void Decimator::collapse_in_regions() {
   live_edges_ = {};
   phase_lists_ = {};
   phase_histograms_ = {};
+  phase_order_ = {};
 }
 
 std::size_t Decimator::collapse_phase() {
@@ -1160,13 +1163,20 @@ std::size_t Decimator::collapse_phase() {
   for (Worker& w : workers_)
     w.face_budget = std::size_t(double(faces_ - target_) * double(w.queue.size()) / double(total));
 
-  // 3. The regions, on all threads; each thread takes the next region left.
+  // 3. The regions, on all threads; each thread takes the next region left, the largest
+  // queues first, so that no thread is left with a long one while the others wait.
+  std::vector<std::uint16_t>& order = phase_order_;
+  order.resize(regions_);
+  std::iota(order.begin(), order.end(), std::uint16_t(0));
+  std::stable_sort(order.begin(), order.end(), [&](std::uint16_t x, std::uint16_t y) {
+    return workers_[x].queue.size() > workers_[y].queue.size();
+  });
   std::atomic<std::size_t> next{0};
   parallel_for(
       n_parts, opt_.threads,
       [&](std::size_t begin, std::size_t end) {
         for (std::size_t t = begin; t < end; ++t)
-          for (std::size_t r; (r = next.fetch_add(1)) < regions_;) collapse_region(workers_[r]);
+          for (std::size_t r; (r = next.fetch_add(1)) < regions_;) collapse_region(workers_[order[r]]);
       },
       1);
 
