@@ -399,7 +399,9 @@ class Decimator {
     kRefusals
   };
   Refusal check(Halfedge h, const Point& target, Scratch& s, std::uint16_t region = kNoRegion) const;
-  bool triangle_ok(const Vec3d& old_apex, const Vec3d& new_apex, const Vec3d& a, const Vec3d& b, Scratch& s) const;
+  // Inline in check(), whatever GCC's budget for the file says: out of line it costs 2 % more.
+  [[gnu::always_inline]] bool triangle_ok(const Vec3d& old_apex, const Vec3d& new_apex, const Vec3d& a, const Vec3d& b,
+                                          Scratch& s) const;
   // What a collapse changed, for the queue to follow up.
   struct Collapsed {
     Vertex kept;
@@ -1234,8 +1236,8 @@ void Decimator::collapse_region(Worker& w) {
 }
 
 // Rotation limit and degeneracy of one triangle (apex, a, b) when its apex moves.
-bool Decimator::triangle_ok(const Vec3d& old_apex, const Vec3d& new_apex, const Vec3d& a, const Vec3d& b,
-                            Scratch& s) const {
+inline bool Decimator::triangle_ok(const Vec3d& old_apex, const Vec3d& new_apex, const Vec3d& a, const Vec3d& b,
+                                   Scratch& s) const {
   if (opt_.prevent_flips) {
     const Vec3d n_old = cross(a - old_apex, b - old_apex);
     const Vec3d ea = a - new_apex, eb = b - new_apex;
