@@ -77,13 +77,15 @@ struct Quadric {
   Vec3d linear() const { return {{g0, g1, g2}}; }
   double value(const Vec3d& u) const { return dot(u, times(u)) + 2 * dot(u, linear()) + k; }
   double operator()(const Vec3d& u) const { return std::max(0.0, value(u)); }
+  //! The weight of pulled_towards()'s pull (strength / 3 is a constant: no division).
+  double pull_weight(double strength) const { return strength / 3 * (a00 + a11 + a22); }
   //! Plus a small isotropic pull towards `center`, `strength` times the mean curvature of
   //! A: it settles the directions the planes leave free (flat or cylindrical regions),
   //! where the bare minimum drifts along the surface, without moving the well-determined
   //! ones by more than that fraction.
   Quadric pulled_towards(const Vec3d& center, double strength) const {
     Quadric q = *this;
-    const double lambda = strength / 3 * (a00 + a11 + a22);  // strength / 3 folds: no division
+    const double lambda = pull_weight(strength);
     q.a00 += lambda, q.a11 += lambda, q.a22 += lambda;
     q.g0 -= lambda * center[0], q.g1 -= lambda * center[1], q.g2 -= lambda * center[2];
     q.k += lambda * sqrnorm(center);
@@ -721,7 +723,8 @@ double Decimator::shapes_cost(Vertex a, Vertex b, const Vec3d& p, double s) cons
   for (std::size_t k = 0; k < shapes_.size(); ++k) {
     const Vec3d oa = shape_offset(k, a), ob = shape_offset(k, b);
     const Vec3d ab = at(b) + ob - at(a) - oa;  // b relative to a, in shape k
-    const Quadric q = shape_quadric(k, a) + shape_quadric(k, b).shifted(-ab);
+    const std::size_t n = shapes_.size();
+    const Quadric q = merged_about_first(shape_quadrics_[a.idx() * n + k], shape_quadrics_[b.idx() * n + k], ab);
     cost += q(p + (ob - oa) * s);
   }
   return cost;
@@ -896,7 +899,7 @@ bool Decimator::evaluate(Edge e, Candidate& c) const {
       // p solves (A + lambda I) p = lambda c - g, so A p = lambda (c - p) - g and the
       // quadric there is g.p + lambda p.(c - p) + k, without a product by A.
       const Vec3d center = ab * 0.5;
-      const double lambda = kPull / 3 * (q.a00 + q.a11 + q.a22);
+      const double lambda = q.pull_weight(kPull);
       cost = std::max(0.0, dot(q.linear(), p) + lambda * dot(p, center - p) + q.k);
     }
     if (touches_boundary) cost += boundary_weight * boundary_shift(h0, pa + p);
