@@ -128,8 +128,10 @@ struct PackedQuadric {
 
 // The quadric of an edge's two ends about a's place, a and b stored about their own places
 // and b at ab from a: what unpack() + unpack().shifted(-ab) gives, the same operations in
-// the same order, written out so that no intermediate quadric goes through memory.
-inline Quadric merged_about_first(const PackedQuadric& a, const PackedQuadric& b, const Vec3d& ab) {
+// the same order, written out so that no intermediate quadric goes through memory. Always
+// inline: it is evaluate()'s core, and GCC stops inlining it once it has several callers.
+[[gnu::always_inline]] inline Quadric merged_about_first(const PackedQuadric& a, const PackedQuadric& b,
+                                                         const Vec3d& ab) {
   const double d0 = -ab[0], d1 = -ab[1], d2 = -ab[2];
   const double b00 = b.a00, b01 = b.a01, b02 = b.a02, b11 = b.a11, b12 = b.a12, b22 = b.a22;
   const double bg0 = b.g0, bg1 = b.g1, bg2 = b.g2;
@@ -344,8 +346,9 @@ class Decimator {
     return Vec3d{{o[0], o[1], o[2]}} * inv_scale_;
   }
   Vec3d shape_at(std::size_t k, Vertex v) const { return at(v) + shape_offset(k, v); }
-  Quadric shape_quadric(std::size_t k, Vertex v) const {
-    return shape_quadrics_[v.idx() * shapes_.size() + k].unpack();
+  PackedQuadric& shape_quadric(std::size_t k, Vertex v) { return shape_quadrics_[v.idx() * shapes_.size() + k]; }
+  const PackedQuadric& shape_quadric(std::size_t k, Vertex v) const {
+    return shape_quadrics_[v.idx() * shapes_.size() + k];
   }
   double shapes_cost(Vertex a, Vertex b, const Vec3d& p, double s) const;
   double shapes_weight(Vertex a, Vertex b) const;
@@ -638,7 +641,7 @@ void Decimator::compute_quadrics() {
       for (std::size_t k = 0; k < shapes_.size(); ++k) {
         Quadric qk = face_planes(v, [&](Vertex w) { return shape_at(k, w); });
         if (!weight_factor_.empty()) qk *= weight_factor_[i];
-        shape_quadrics_[i * shapes_.size() + k].store(qk);
+        shape_quadric(k, v).store(qk);
       }
     };
     for (std::size_t j = begin; j < end; ++j) {
@@ -723,8 +726,7 @@ double Decimator::shapes_cost(Vertex a, Vertex b, const Vec3d& p, double s) cons
   for (std::size_t k = 0; k < shapes_.size(); ++k) {
     const Vec3d oa = shape_offset(k, a), ob = shape_offset(k, b);
     const Vec3d ab = at(b) + ob - at(a) - oa;  // b relative to a, in shape k
-    const std::size_t n = shapes_.size();
-    const Quadric q = merged_about_first(shape_quadrics_[a.idx() * n + k], shape_quadrics_[b.idx() * n + k], ab);
+    const Quadric q = merged_about_first(shape_quadric(k, a), shape_quadric(k, b), ab);
     cost += q(p + (ob - oa) * s);
   }
   return cost;
@@ -733,8 +735,8 @@ double Decimator::shapes_cost(Vertex a, Vertex b, const Vec3d& p, double s) cons
 double Decimator::shapes_weight(Vertex a, Vertex b) const {
   double w = 0;
   for (std::size_t k = 0; k < shapes_.size(); ++k) {
-    w += double(shape_quadrics_[a.idx() * shapes_.size() + k].weight);
-    w += double(shape_quadrics_[b.idx() * shapes_.size() + k].weight);
+    w += double(shape_quadric(k, a).weight);
+    w += double(shape_quadric(k, b).weight);
   }
   return w;
 }
@@ -1583,7 +1585,7 @@ Decimator::Collapsed Decimator::apply_collapse(Halfedge h, const Candidate& c, S
   VertexData &d0 = vd_[v0.idx()], &d1 = vd_[v1.idx()];
   const Vec3d c0 = to_double(d0.position), c1 = to_double(d1.position);
   const Vec3d moved = local(v1);
-  d1.quadric.store((d1.quadric.unpack() + d0.quadric.unpack().shifted(c1 - c0)).shifted(moved - c1));
+  d1.quadric.store(merged_about_first(d1.quadric, d0.quadric, c0 - c1).shifted(moved - c1));
   s.shape_before.resize(2 * shapes_.size());
   for (std::size_t k = 0; k < shapes_.size(); ++k) {
     s.shape_before[2 * k] = shape_at(k, v0);
@@ -1594,8 +1596,8 @@ Decimator::Collapsed Decimator::apply_collapse(Halfedge h, const Candidate& c, S
   // Each shape's merged quadric, about the new vertex's place there (its blended offset).
   for (std::size_t k = 0; k < shapes_.size(); ++k) {
     const Vec3d k0 = s.shape_before[2 * k], k1 = s.shape_before[2 * k + 1];
-    PackedQuadric& q1 = shape_quadrics_[v1.idx() * shapes_.size() + k];
-    q1.store((q1.unpack() + shape_quadric(k, v0).shifted(k1 - k0)).shifted(shape_at(k, v1) - k1));
+    PackedQuadric& q1 = shape_quadric(k, v1);
+    q1.store(merged_about_first(q1, shape_quadric(k, v0), k0 - k1).shifted(shape_at(k, v1) - k1));
   }
   if (!corner_channels_.empty()) blend_wedges(v1, s);
 
