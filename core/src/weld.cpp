@@ -3,12 +3,16 @@
 //   2. baseline: the input's defects around those vertices;
 //   3. repeat until nothing moves: find the output's defects there, and for each one the
 //      input did not have, give the copies that make it their own output vertex.
+//   4. count: where the output still has more of a kind of defect than the input (a pinch
+//      of the mesh itself can take the place of an input edge the weld restores), that kind
+//      is judged strictly (every one new) and step 3 runs again.
 // Moving a copy out of a weld never makes an edge carry more faces or two faces one vertex
 // set; a vertex it leaves with two fans is split in the next pass. Every move makes a weld
-// smaller, so the passes stop.
+// smaller, and each kind turns strict once, so the passes stop.
 #include "weld.h"
 
 #include <algorithm>
+#include <array>
 #include <numeric>
 #include <tuple>
 #include <utility>
@@ -192,7 +196,10 @@ class Guard {
 
   std::size_t run() {
     if (!watch()) return 0;
-    const Baseline baseline(input_faces());
+    const Faces input = input_faces();
+    const Baseline baseline(input);
+    const Counts limit = counts(input, find_defects(input));
+    std::array<bool, 4> strict{};  // by kind: every defect of it counts as new
     std::size_t moved = 0;
     for (;;) {
       for (std::uint32_t v : moved_now_) moved_flag_[v] = 0;
@@ -202,25 +209,30 @@ class Guard {
       const std::size_t before = moved;
       for (auto [i, j] : found.nm_edges) {
         const Side& s = found.sides[i];
-        if (!ours(s.lo) || !ours(s.hi) || Baseline::has(baseline.nm_edges, {s.lo, s.hi})) continue;
+        if (!ours(s.lo) || !ours(s.hi) || (!strict[0] && Baseline::has(baseline.nm_edges, {s.lo, s.hi}))) continue;
         moved += split_edge(faces, found, i, j);
       }
       for (const auto& fans : found.nm_vertices)
-        if (!Baseline::has(baseline.nm_vertices, fans.key)) moved += split_fans(faces, fans);
+        if (strict[1] || !Baseline::has(baseline.nm_vertices, fans.key)) moved += split_fans(faces, fans);
       // A key set the input had on several faces may come back on as many, no more.
       for (const auto& group : found.duplicates) {
         const std::vector<Key> set = faces.key_set(group[0]);
-        const std::size_t keep = Baseline::faces_with(baseline.duplicates, set, 1);
-        if (std::all_of(set.begin(), set.end(), [&](Key k) { return ours(k); }) && group.size() > keep)
-          moved += split_duplicate(faces, group, keep);
+        const std::size_t keep = strict[2] ? 1 : Baseline::faces_with(baseline.duplicates, set, 1);
+        if (all_ours(set) && group.size() > keep) moved += split_duplicate(faces, group, keep);
       }
       // Faces repeating a vertex, as often as the input had their key set (an Euler edit or
       // an operation can cut a face build() let repeat its vertex into pieces that repeat it).
       for (const auto& group : found.repeating) {
-        const std::size_t keep = Baseline::faces_with(baseline.repeating, faces.key_set(group[0]), 0);
+        const std::size_t keep = strict[3] ? 0 : Baseline::faces_with(baseline.repeating, faces.key_set(group[0]), 0);
         for (std::size_t k = keep; k < group.size(); ++k) moved += split_repeat(faces, group[k]);
       }
-      if (moved == before) return moved;
+      if (moved != before) continue;
+      // Settled by key; now by count.
+      const Counts now = counts(faces, found);
+      bool stricter = false;
+      for (std::size_t k = 0; k < now.size(); ++k)
+        if (now[k] > limit[k] && !strict[k]) strict[k] = stricter = true;
+      if (!stricter) return moved;
     }
   }
 
@@ -253,6 +265,23 @@ class Guard {
   //! splits such an edge in two, such a face in four). Its non-manifold vertices are not.
   bool ours(Key k) const { return k >= kOwnKey || k < input_.n_vertices(); }
   bool representative(std::uint32_t v) const { return weld_.order[weld_.vmap[v]] == v; }
+  bool all_ours(const std::vector<Key>& set) const {
+    return std::all_of(set.begin(), set.end(), [&](Key k) { return ours(k); });
+  }
+
+  // ---- pass 4: count -----------------------------------------------------------------
+  //! How many of each kind (non-manifold edges and vertices, duplicate faces, faces
+  //! repeating a vertex) the guard answers for: those step 3 would split if they were new.
+  using Counts = std::array<std::size_t, 4>;
+  Counts counts(const Faces& faces, const Defects& d) const {
+    Counts n{};
+    for (auto [i, j] : d.nm_edges) n[0] += ours(d.sides[i].lo) && ours(d.sides[i].hi);
+    n[1] = d.nm_vertices.size();
+    for (const auto& group : d.duplicates)
+      if (all_ours(faces.key_set(group[0]))) n[2] += group.size() - 1;
+    for (const auto& group : d.repeating) n[3] += group.size();
+    return n;
+  }
 
   // ---- pass 2: baseline --------------------------------------------------------------
   Faces input_faces() const {
