@@ -158,8 +158,7 @@ struct Baseline {
   std::vector<Key> nm_vertices;
   std::vector<std::pair<std::vector<Key>, std::size_t>> duplicates, repeating;  // (key set, faces with it)
 
-  explicit Baseline(const Faces& faces) {
-    const Defects d = find_defects(faces);
+  Baseline(const Faces& faces, const Defects& d) {
     for (auto [i, j] : d.nm_edges) nm_edges.emplace_back(d.sides[i].lo, d.sides[i].hi);
     for (const auto& fans : d.nm_vertices) nm_vertices.push_back(fans.key);
     for (const auto& group : d.duplicates) duplicates.emplace_back(faces.key_set(group[0]), group.size());
@@ -197,8 +196,9 @@ class Guard {
   std::size_t run() {
     if (!watch()) return 0;
     const Faces input = input_faces();
-    const Baseline baseline(input);
-    const Counts limit = counts(input, find_defects(input));
+    const Defects input_defects = find_defects(input);
+    const Baseline baseline(input, input_defects);
+    const Counts limit = counts(input, input_defects);
     std::array<bool, 4> strict{};  // by kind: every defect of it counts as new
     std::size_t moved = 0;
     for (;;) {
