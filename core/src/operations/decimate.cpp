@@ -77,20 +77,6 @@ struct Quadric {
   Vec3d linear() const { return {{g0, g1, g2}}; }
   double value(const Vec3d& u) const { return dot(u, times(u)) + 2 * dot(u, linear()) + k; }
   double operator()(const Vec3d& u) const { return std::max(0.0, value(u)); }
-  //! The weight of pulled_towards()'s pull (strength / 3 is a constant: no division).
-  double pull_weight(double strength) const { return strength / 3 * (a00 + a11 + a22); }
-  //! Plus a small isotropic pull towards `center`, `strength` times the mean curvature of
-  //! A: it settles the directions the planes leave free (flat or cylindrical regions),
-  //! where the bare minimum drifts along the surface, without moving the well-determined
-  //! ones by more than that fraction.
-  Quadric pulled_towards(const Vec3d& center, double strength) const {
-    Quadric q = *this;
-    const double lambda = pull_weight(strength);
-    q.a00 += lambda, q.a11 += lambda, q.a22 += lambda;
-    q.g0 -= lambda * center[0], q.g1 -= lambda * center[1], q.g2 -= lambda * center[2];
-    q.k += lambda * sqrnorm(center);
-    return q;
-  }
   //! The same quadric about the origin moved by delta.
   Quadric shifted(const Vec3d& delta) const {
     Quadric q = *this;
@@ -98,20 +84,6 @@ struct Quadric {
     q.g0 += ad[0], q.g1 += ad[1], q.g2 += ad[2];
     q.k = dot(delta, ad) + 2 * dot(delta, linear()) + k;
     return q;
-  }
-
-  // The minimum, when the 3x3 part is well conditioned. The test det > eps tr^3 is
-  // invariant under rotation and scale and keeps the smallest eigenvalue above eps tr.
-  bool minimum(Vec3d& u) const {
-    const double c00 = a11 * a22 - a12 * a12, c01 = a02 * a12 - a01 * a22, c02 = a01 * a12 - a02 * a11;
-    const double c11 = a00 * a22 - a02 * a02, c12 = a01 * a02 - a00 * a12, c22 = a00 * a11 - a01 * a01;
-    const double det = a00 * c00 + a01 * c01 + a02 * c02;
-    const double tr = a00 + a11 + a22;
-    if (!(det > 1e-9 * tr * tr * tr)) return false;
-    const double inv = -1.0 / det;
-    u = {{(c00 * g0 + c01 * g1 + c02 * g2) * inv, (c01 * g0 + c11 * g1 + c12 * g2) * inv,
-          (c02 * g0 + c12 * g1 + c22 * g2) * inv}};
-    return true;
   }
 };
 
@@ -126,25 +98,95 @@ struct PackedQuadric {
   }
 };
 
+// Two doubles side by side: two edges measured at once, each lane doing exactly the
+// operations one edge does alone, so each gets the same bits (x86-64's baseline has no
+// fused multiply-add for the compiler to contract into).
+using DoublePair = double __attribute__((vector_size(16)));
+// What comparing lanes gives: bool for double, a mask of lanes for DoublePair.
+template <class T>
+using LaneMask = decltype(T{} > T{});
+
+// A quadric without its weight, in lanes of type T (double: one edge; DoublePair: two).
+template <class T>
+struct QuadricLanes {
+  T a00, a01, a02, a11, a12, a22, g0, g1, g2, k;
+};
+
 // The quadric of an edge's two ends about a's place, a and b stored about their own places
 // and b at ab from a: what unpack() + unpack().shifted(-ab) gives, the same operations in
-// the same order, written out so that no intermediate quadric goes through memory. Always
-// inline: it is evaluate()'s core, and GCC stops inlining it once it has several callers.
+// the same order, written out so that no intermediate quadric goes through memory. `a(f)`
+// and `b(f)` give the lanes of field f of the ends' packed quadrics. Always inline: it is
+// evaluate()'s core, and GCC stops inlining it once it has several callers.
+template <class T, class Lanes>
+[[gnu::always_inline]] inline QuadricLanes<T> merge_lanes(Lanes a, Lanes b, T ab0, T ab1, T ab2) {
+  const T d0 = -ab0, d1 = -ab1, d2 = -ab2;
+  const T b00 = b(&PackedQuadric::a00), b01 = b(&PackedQuadric::a01), b02 = b(&PackedQuadric::a02);
+  const T b11 = b(&PackedQuadric::a11), b12 = b(&PackedQuadric::a12), b22 = b(&PackedQuadric::a22);
+  const T bg0 = b(&PackedQuadric::g0), bg1 = b(&PackedQuadric::g1), bg2 = b(&PackedQuadric::g2);
+  const T ad0 = b00 * d0 + b01 * d1 + b02 * d2, ad1 = b01 * d0 + b11 * d1 + b12 * d2,
+          ad2 = b02 * d0 + b12 * d1 + b22 * d2;
+  const T bk =
+      (0.0 + d0 * ad0 + d1 * ad1 + d2 * ad2) + 2.0 * (0.0 + d0 * bg0 + d1 * bg1 + d2 * bg2) + b(&PackedQuadric::k);
+  return {a(&PackedQuadric::a00) + b00,        a(&PackedQuadric::a01) + b01,
+          a(&PackedQuadric::a02) + b02,        a(&PackedQuadric::a11) + b11,
+          a(&PackedQuadric::a12) + b12,        a(&PackedQuadric::a22) + b22,
+          a(&PackedQuadric::g0) + (bg0 + ad0), a(&PackedQuadric::g1) + (bg1 + ad1),
+          a(&PackedQuadric::g2) + (bg2 + ad2), a(&PackedQuadric::k) + bk};
+}
+
+// The lanes of one packed quadric's fields, as doubles.
+inline auto lanes_of(const PackedQuadric& q) {
+  return [&q](float PackedQuadric::*f) { return double(q.*f); };
+}
+
 [[gnu::always_inline]] inline Quadric merged_about_first(const PackedQuadric& a, const PackedQuadric& b,
                                                          const Vec3d& ab) {
-  const double d0 = -ab[0], d1 = -ab[1], d2 = -ab[2];
-  const double b00 = b.a00, b01 = b.a01, b02 = b.a02, b11 = b.a11, b12 = b.a12, b22 = b.a22;
-  const double bg0 = b.g0, bg1 = b.g1, bg2 = b.g2;
-  const double ad0 = b00 * d0 + b01 * d1 + b02 * d2, ad1 = b01 * d0 + b11 * d1 + b12 * d2,
-               ad2 = b02 * d0 + b12 * d1 + b22 * d2;
-  const double bk = (0.0 + d0 * ad0 + d1 * ad1 + d2 * ad2) + 2 * (0.0 + d0 * bg0 + d1 * bg1 + d2 * bg2) + double(b.k);
-  Quadric q;
-  q.a00 = double(a.a00) + b00, q.a01 = double(a.a01) + b01, q.a02 = double(a.a02) + b02;
-  q.a11 = double(a.a11) + b11, q.a12 = double(a.a12) + b12, q.a22 = double(a.a22) + b22;
-  q.g0 = double(a.g0) + (bg0 + ad0), q.g1 = double(a.g1) + (bg1 + ad1), q.g2 = double(a.g2) + (bg2 + ad2);
-  q.k = double(a.k) + bk;
-  q.weight = double(a.weight) + double(b.weight);
-  return q;
+  const QuadricLanes<double> m = merge_lanes<double>(lanes_of(a), lanes_of(b), ab[0], ab[1], ab[2]);
+  return {m.a00, m.a01, m.a02, m.a11, m.a12, m.a22, m.g0, m.g1, m.g2, m.k, double(a.weight) + double(b.weight)};
+}
+
+// Pull of the optimal placement towards the edge's midpoint, relative to the quadric's mean
+// eigenvalue. 1% keeps new vertices inside their neighbourhood in flat and cylindrical
+// regions (better triangles, attributes interpolated inside the old triangles) for about
+// 10% more mean error and no change in the Hausdorff distance on the dragon.
+constexpr double kPull = 0.01;
+
+// Where an edge's merged quadric q (about a, b at ab) is least once pulled towards the
+// edge's middle c: the solution of (A + lambda I) u = lambda c - g, lambda kPull times A's
+// mean eigenvalue. The pull settles the directions the planes leave free (flat or
+// cylindrical regions), where the bare minimum drifts along the surface, without moving
+// the well-determined ones by more than that fraction. Found when the system is well
+// conditioned (det > eps tr^3, invariant under rotation and scale, keeps the smallest
+// eigenvalue above eps tr) and u lies within the edge's length of c (a nearly flat
+// neighbourhood can put it far along a valley of the quadric: a numerical accident, not a
+// better surface). The cost there is q(u) = g.u + lambda u.(c - u) + k, from the solved
+// system without a product by A, and at least 0.
+template <class T>
+struct PulledMinimum {
+  T u0, u1, u2, cost;
+  LaneMask<T> found;
+};
+
+template <class T>
+[[gnu::always_inline]] inline PulledMinimum<T> pulled_minimum(const QuadricLanes<T>& q, T ab0, T ab1, T ab2) {
+  const T c0 = ab0 * 0.5, c1 = ab1 * 0.5, c2 = ab2 * 0.5;
+  const T lambda = kPull / 3 * (q.a00 + q.a11 + q.a22);
+  const T a00 = q.a00 + lambda, a11 = q.a11 + lambda, a22 = q.a22 + lambda;
+  const T a01 = q.a01, a02 = q.a02, a12 = q.a12;
+  const T g0 = q.g0 - lambda * c0, g1 = q.g1 - lambda * c1, g2 = q.g2 - lambda * c2;
+  const T m00 = a11 * a22 - a12 * a12, m01 = a02 * a12 - a01 * a22, m02 = a01 * a12 - a02 * a11;
+  const T m11 = a00 * a22 - a02 * a02, m12 = a01 * a02 - a00 * a12, m22 = a00 * a11 - a01 * a01;
+  const T det = a00 * m00 + a01 * m01 + a02 * m02;
+  const T tr = a00 + a11 + a22;
+  const T inv = -1.0 / det;
+  const T u0 = (m00 * g0 + m01 * g1 + m02 * g2) * inv, u1 = (m01 * g0 + m11 * g1 + m12 * g2) * inv,
+          u2 = (m02 * g0 + m12 * g1 + m22 * g2) * inv;
+  const T o0 = u0 - c0, o1 = u1 - c1, o2 = u2 - c2;
+  const T reach = 4.0 * (0.0 + ab0 * ab0 + ab1 * ab1 + ab2 * ab2);
+  const T value = (0.0 + q.g0 * u0 + q.g1 * u1 + q.g2 * u2) +
+                  lambda * (0.0 + u0 * (c0 - u0) + u1 * (c1 - u1) + u2 * (c2 - u2)) + q.k;
+  return {u0, u1, u2, 0.0 < value ? value : T{},
+          LaneMask<T>((det > 1e-9 * tr * tr * tr) & ((0.0 + o0 * o0 + o1 * o1 + o2 * o2) <= reach))};
 }
 
 // The queue of edges by cost: a radix heap (Ahuja, Mehlhorn, Orlin & Tarjan 1990) over the
@@ -272,12 +314,6 @@ constexpr double kBoundaryWeight = 10;
 // Quadrics are stored in floats: a weight far beyond this would only blur their precision.
 constexpr double kMaxWeightStrength = 1000;
 
-// Pull of the optimal placement towards the edge's midpoint, relative to the quadric's mean
-// eigenvalue. 1% keeps new vertices inside their neighbourhood in flat and cylindrical
-// regions (better triangles, attributes interpolated inside the old triangles) for about
-// 10% more mean error and no change in the Hausdorff distance on the dragon.
-constexpr double kPull = 0.01;
-
 // Collapsing in regions (Decimator::collapse_in_regions): from this many faces on, while
 // more than kTailShare of the faces to remove, and of the target, are left (and at least
 // kMinPhase collapses' worth). A phase's passes cost in proportion to the mesh left, the
@@ -373,6 +409,17 @@ class Decimator {
   // stale) when it costs at most w.max_cost; an edge without any legal placement just loses
   // its entries. During the phases its cost is kept too.
   void requeue(Edge e, Worker& w);
+  void requeue(Edge e, float cost, Worker& w);
+  // An edge with neither end flagged (boundary, seam, lock) and no shape keys: the common
+  // case, whose cost measure_pair() finds two at a time.
+  bool plain(Edge e) const {
+    return shapes_.empty() && (vd_[m_.vertex(e, 0).idx()].flags | vd_[m_.vertex(e, 1).idx()].flags) == 0;
+  }
+  // measure() of two plain edges, side by side in the lanes of DoublePair: the same bits.
+  void measure_pair(Edge e0, Edge e1, float& cost0, float& cost1) const;
+  // cost(i) = measure(edge(i)) for i < n, the plain edges two at a time.
+  template <class EdgeAt, class CostAt>
+  void measure_all(std::size_t n, EdgeAt edge, CostAt cost) const;
 
   // ---- fetching ahead ------------------------------------------------------------------
   // Each collapse starts with cache misses: the popped edge lies anywhere in the mesh, and its
@@ -881,28 +928,25 @@ bool Decimator::evaluate(Edge e, Candidate& c) const {
     const double dd = sqrnorm(d);
     Vec3d p;
     bool found = false;
+    double cost = 0;
     // Seams move only along themselves: the minimum over the edge keeps the new vertex on
     // the seam line, where both charts' coordinates can be interpolated.
-    if (!seam && q.pulled_towards(ab * 0.5, kPull).minimum(p)) {
-      // A nearly flat neighbourhood can put the minimum far along a valley of the quadric;
-      // such a point is a numerical accident, not a better surface.
-      found = sqrnorm(p - ab * 0.5) <= 4 * dd;
+    if (!seam) {
+      const QuadricLanes<double> lanes{q.a00, q.a01, q.a02, q.a11, q.a12, q.a22, q.g0, q.g1, q.g2, q.k};
+      const PulledMinimum<double> m = pulled_minimum(lanes, ab[0], ab[1], ab[2]);
+      found = m.found;
+      p = {{m.u0, m.u1, m.u2}};
+      cost = m.cost;
     }
     double t = 0.5;  // along the edge from the removed vertex, for attribute interpolation
-    double cost;
     if (!found) {
       const double curvature = dot(d, q.times(d));
       const double slope = dot(q.times(from) + q.linear(), d);
       t = curvature > 0 ? std::clamp(-slope / curvature, 0.0, 1.0) : (slope > 0 ? 0.0 : slope < 0 ? 1.0 : 0.5);
       p = from + d * t;
       cost = q(p);
-    } else {
-      if (kPlace || !shapes_.empty()) t = dd > 0 ? std::clamp(dot(p - from, d) / dd, 0.0, 1.0) : 0.5;
-      // p solves (A + lambda I) p = lambda c - g, so A p = lambda (c - p) - g and the
-      // quadric there is g.p + lambda p.(c - p) + k, without a product by A.
-      const Vec3d center = ab * 0.5;
-      const double lambda = q.pull_weight(kPull);
-      cost = std::max(0.0, dot(q.linear(), p) + lambda * dot(p, center - p) + q.k);
+    } else if (kPlace || !shapes_.empty()) {
+      t = dd > 0 ? std::clamp(dot(p - from, d) / dd, 0.0, 1.0) : 0.5;
     }
     if (touches_boundary) cost += boundary_weight * boundary_shift(h0, pa + p);
     if (!shapes_.empty()) cost += shapes_cost(a, b, p, remove_a ? t : 1 - t);
@@ -933,6 +977,49 @@ bool Decimator::evaluate(Edge e, Candidate& c) const {
     c.side = keep_b ? 0 : 1;
   }
   return true;
+}
+
+// evaluate<false>()'s path for two plain edges: both ends free, a removed; where a lane's
+// minimum is not found, that edge goes through evaluate() alone.
+void Decimator::measure_pair(Edge e0, Edge e1, float& cost0, float& cost1) const {
+  const VertexData *a[2], *b[2];
+  for (int i = 0; i < 2; ++i) {
+    const Halfedge h0 = Mesh::halfedge(i == 0 ? e0 : e1, 0);
+    b[i] = &vd_[m_.to_vertex(h0).idx()];
+    a[i] = &vd_[m_.to_vertex(Mesh::opposite(h0)).idx()];
+  }
+  auto lanes = [](const VertexData* const* d) {
+    return [d](float PackedQuadric::*f) { return DoublePair{double(d[0]->quadric.*f), double(d[1]->quadric.*f)}; };
+  };
+  auto position = [](const VertexData* const* d, int i) {
+    return DoublePair{double(d[0]->position[i]), double(d[1]->position[i])};
+  };
+  const DoublePair ab0 = position(b, 0) - position(a, 0), ab1 = position(b, 1) - position(a, 1),
+                   ab2 = position(b, 2) - position(a, 2);
+  const PulledMinimum<DoublePair> m =
+      pulled_minimum(merge_lanes<DoublePair>(lanes(a), lanes(b), ab0, ab1, ab2), ab0, ab1, ab2);
+  cost0 = m.found[0] ? static_cast<float>(m.cost[0]) : measure(e0);
+  cost1 = m.found[1] ? static_cast<float>(m.cost[1]) : measure(e1);
+}
+
+template <class EdgeAt, class CostAt>
+void Decimator::measure_all(std::size_t n, EdgeAt edge, CostAt cost) const {
+  constexpr std::size_t kAhead = 8;  // edges: their half-edges may stream in, their ends do not
+  std::size_t waiting = n;           // a plain edge without its pair yet
+  for (std::size_t i = 0; i < n; ++i) {
+    if (i + kAhead < n)
+      for (unsigned side = 0; side < 2; ++side) detail::prefetch(&vd_[m_.vertex(edge(i + kAhead), side).idx()]);
+    const Edge e = edge(i);
+    if (m_.is_deleted(e) || !plain(e)) {
+      cost(i) = measure(e);
+    } else if (waiting == n) {
+      waiting = i;
+    } else {
+      measure_pair(edge(waiting), e, cost(waiting), cost(i));
+      waiting = n;
+    }
+  }
+  if (waiting != n) cost(waiting) = measure(edge(waiting));
 }
 
 // The current collapse may change the neighbourhood being fetched between two steps; the
@@ -991,13 +1078,9 @@ void Decimator::measure_edges() {
   const std::size_t n = m_.edges_size();
   cost_.resize(n);
   parallel_for(n, opt_.threads, [&](std::size_t begin, std::size_t end) {
-    constexpr std::size_t kAhead = 8;  // edges: the half-edges stream in, the end vertices do not
-    for (std::size_t i = begin; i < end; ++i) {
-      if (i + kAhead < end)
-        for (unsigned side = 0; side < 2; ++side)
-          detail::prefetch(&vd_[m_.vertex(Edge(static_cast<Index>(i + kAhead)), side).idx()]);
-      cost_[i] = measure(Edge(static_cast<Index>(i)));
-    }
+    measure_all(
+        end - begin, [&](std::size_t i) { return Edge(static_cast<Index>(begin + i)); },
+        [&](std::size_t i) -> float& { return cost_[begin + i]; });
   });
 }
 
@@ -1012,9 +1095,10 @@ void Decimator::fill_heap() {
   cost_ = {};
 }
 
-void Decimator::requeue(Edge e, Worker& w) {
+void Decimator::requeue(Edge e, Worker& w) { requeue(e, measure(e), w); }
+
+void Decimator::requeue(Edge e, float cost, Worker& w) {
   const std::uint8_t v = ++version_[e.idx()];
-  const float cost = measure(e);
   if (!cost_.empty()) cost_[e.idx()] = cost;
   if (cost == kNoCost || cost > w.max_cost) return;
   if (w.region != kNoRegion && (border_[m_.vertex(e, 0).idx()] || border_[m_.vertex(e, 1).idx()])) return;
@@ -1649,9 +1733,27 @@ int Decimator::collapse(Halfedge h, const Candidate& c, Worker& w) {
   // Every edge at the kept vertex changed (its neighbours are all in the region): evaluate
   // them now, while their half-edges are in cache (one sweep to fetch the neighbours' data,
   // one to evaluate), rather than when they surface cold.
-  for (Halfedge x : m_.outgoing(done.kept)) detail::prefetch(&vd_[m_.to_vertex(x).idx()]);
+  // All measured first (the plain ones two at a time), then queued in ring order.
+  constexpr std::size_t kMaxRing = 32;
+  Edge ring[kMaxRing];
+  float costs[kMaxRing];
+  std::size_t n = 0;
   for (Halfedge x : m_.outgoing(done.kept)) {
-    requeue(Mesh::edge(x), w);
+    detail::prefetch(&vd_[m_.to_vertex(x).idx()]);
+    if (n < kMaxRing) ring[n] = Mesh::edge(x);
+    ++n;
+  }
+  if (n > kMaxRing) {
+    for (Halfedge x : m_.outgoing(done.kept)) {
+      requeue(Mesh::edge(x), w);
+      fetch_ahead(w.scratch);
+    }
+    return done.removed_faces;
+  }
+  measure_all(
+      n, [&](std::size_t i) { return ring[i]; }, [&](std::size_t i) -> float& { return costs[i]; });
+  for (std::size_t i = 0; i < n; ++i) {
+    requeue(ring[i], costs[i], w);
     fetch_ahead(w.scratch);
   }
   return done.removed_faces;
