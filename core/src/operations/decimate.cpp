@@ -1733,29 +1733,26 @@ int Decimator::collapse(Halfedge h, const Candidate& c, Worker& w) {
   // Every edge at the kept vertex changed (its neighbours are all in the region): evaluate
   // them now, while their half-edges are in cache (one sweep to fetch the neighbours' data,
   // one to evaluate), rather than when they surface cold.
-  // All measured first (the plain ones two at a time), then queued in ring order.
+  // Measured a ring's worth at a time (the plain ones two at a time), then queued in ring order.
   constexpr std::size_t kMaxRing = 32;
   Edge ring[kMaxRing];
   float costs[kMaxRing];
   std::size_t n = 0;
-  for (Halfedge x : m_.outgoing(done.kept)) {
-    detail::prefetch(&vd_[m_.to_vertex(x).idx()]);
-    if (n < kMaxRing) ring[n] = Mesh::edge(x);
-    ++n;
-  }
-  if (n > kMaxRing) {
-    for (Halfedge x : m_.outgoing(done.kept)) {
-      requeue(Mesh::edge(x), w);
+  auto measure_and_queue = [&] {
+    measure_all(
+        n, [&](std::size_t i) { return ring[i]; }, [&](std::size_t i) -> float& { return costs[i]; });
+    for (std::size_t i = 0; i < n; ++i) {
+      requeue(ring[i], costs[i], w);
       fetch_ahead(w.scratch);
     }
-    return done.removed_faces;
+    n = 0;
+  };
+  for (Halfedge x : m_.outgoing(done.kept)) {
+    detail::prefetch(&vd_[m_.to_vertex(x).idx()]);
+    ring[n++] = Mesh::edge(x);
+    if (n == kMaxRing) measure_and_queue();
   }
-  measure_all(
-      n, [&](std::size_t i) { return ring[i]; }, [&](std::size_t i) -> float& { return costs[i]; });
-  for (std::size_t i = 0; i < n; ++i) {
-    requeue(ring[i], costs[i], w);
-    fetch_ahead(w.scratch);
-  }
+  measure_and_queue();
   return done.removed_faces;
 }
 
