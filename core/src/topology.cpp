@@ -60,7 +60,8 @@ TopologyStats topology_stats(const Mesh& mesh) {
   s.euler_characteristic = static_cast<std::int64_t>(s.vertices - s.isolated_vertices) -
                            static_cast<std::int64_t>(s.edges) + static_cast<std::int64_t>(s.faces);
   s.genus = (2 * static_cast<std::int64_t>(s.components) - static_cast<std::int64_t>(s.boundary_loops) -
-             s.euler_characteristic) / 2;
+             s.euler_characteristic) /
+            2;
   return s;
 }
 
@@ -86,16 +87,24 @@ std::size_t face_components(const Mesh& mesh, std::vector<Index>& component_of_f
   return next_id;
 }
 
-std::vector<bool> split_seam_edges(const Mesh& mesh) {
+std::vector<std::uint64_t> welded_vertex_ids(const Mesh& mesh) {
   const auto* source = mesh.vertex_properties().get<std::uint32_t>(provenance::kVertexSource);
   if (!source) return {};
   const std::uint64_t n = mesh.vertices_size();
-  auto welded = [&](Vertex v) -> std::uint64_t {
-    const std::uint32_t s = source->vector()[v.idx()];
-    return s != kInvalidIndex ? s : n + v.idx();  // vertices an operation made have no source
-  };
+  std::vector<std::uint64_t> welded(n);
+  for (Index v = 0; v < n; ++v) {
+    const std::uint32_t s = source->vector()[v];
+    welded[v] = s != kInvalidIndex ? s : n + v;
+  }
+  return welded;
+}
+
+std::vector<bool> split_seam_edges(const Mesh& mesh) {
+  const std::vector<std::uint64_t> welded = welded_vertex_ids(mesh);
+  if (welded.empty()) return {};
+  const std::uint64_t n = mesh.vertices_size();
   auto key = [&](Halfedge h) {
-    std::uint64_t a = welded(mesh.from_vertex(h)), b = welded(mesh.to_vertex(h));
+    std::uint64_t a = welded[mesh.from_vertex(h).idx()], b = welded[mesh.to_vertex(h).idx()];
     if (a > b) std::swap(a, b);
     return a * 2 * n + b;  // a, b < 2n
   };

@@ -14,7 +14,7 @@ struct TopologyStats {
   std::size_t isolated_vertices = 0;
   std::size_t boundary_loops = 0;
   std::size_t boundary_edges = 0;
-  std::size_t components = 0;  //!< connected components of faces and edges; isolated vertices not counted
+  std::size_t components = 0;             //!< connected components of faces and edges; isolated vertices not counted
   std::int64_t euler_characteristic = 0;  //!< V - E + F over non-isolated vertices
   std::int64_t genus = 0;                 //!< (2 components - boundary loops - chi) / 2, for orientable surfaces
 };
@@ -25,6 +25,11 @@ TopologyStats topology_stats(const Mesh& mesh);
 //! Component id per face (faces joined by an edge share an id; ids count from 0 in face
 //! order); returns the number of components.
 std::size_t face_components(const Mesh& mesh, std::vector<Index>& component_of_face);
+
+//! Per vertex: the input vertex it stands for once build()'s copies are welded again (its
+//! "hedge:source"), or vertices_size() + its index when it has none (a vertex an operation
+//! made). Empty when `mesh` has no sources.
+std::vector<std::uint64_t> welded_vertex_ids(const Mesh& mesh);
 
 //! Per edge: true for the boundary edges that are seams of build()'s splits, where the
 //! input's surface goes on: welded through the vertices' sources ("hedge:source"), another
