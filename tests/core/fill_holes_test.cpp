@@ -15,6 +15,7 @@
 #include <set>
 #include <vector>
 
+#include "defect_counts.h"
 #include "hedge/build.h"
 #include "hedge/catalogue.h"
 #include "hedge/io.h"
@@ -551,20 +552,52 @@ TEST(FillHoles, SeamsOfSplitNonManifoldEdgesAreNoHoles) {
   EXPECT_EQ(r.triangles_added, 0u);
   EXPECT_EQ(extract(mesh).corners, soup.corners);
 
-  // A real hole beside the glued edge is still filled: drop face (1, 4, 5).
+  // A real hole beside the glued edge is still filled: drop face (1, 4, 5). Its loop runs on
+  // along the split edge through a copy of vertex 1; the hole is the stretch 1, 4, 5 that
+  // comes back to vertex 1, and the patch is the triangle the input lacks.
   soup.corners.erase(soup.corners.begin() + 18, soup.corners.begin() + 21);
   soup.face_sizes.pop_back();
+  soup.add_channel("uv", Domain::corner, ScalarType::f32, 2);  // a UV per vertex: (x + 2, y + 2)
+  for (std::size_t c = 0; c < soup.n_corners(); ++c)
+    for (int k = 0; k < 2; ++k)
+      soup.find("uv", Domain::corner)->as<float>()[2 * c + k] = soup.positions[soup.corners[c]][k] + 2;
   mesh = build(soup).mesh;
   r = fill_holes(mesh);
   EXPECT_EQ(r.holes_found, 1u);
   EXPECT_EQ(r.holes_filled, 1u);
+  EXPECT_EQ(r.holes_on_seams, 0u);
+  EXPECT_EQ(r.triangles_added, 1u);
   ASSERT_VALID(mesh);
-  ExtractReport extracted;
-  const Soup out = extract(mesh, {}, &extracted);
-  for (std::size_t f = 0; f < out.n_faces(); ++f) {
-    const std::uint32_t* c = out.corners.data() + 3 * f;
-    EXPECT_TRUE(c[0] != c[1] && c[1] != c[2] && c[0] != c[2]) << "face " << f;
-  }
+  const Soup out = extract(mesh);
+  ASSERT_EQ(out.n_faces(), soup.n_faces() + 1);
+  EXPECT_TRUE(std::equal(soup.corners.begin(), soup.corners.end(), out.corners.begin()));
+  std::vector<std::uint32_t> patch(out.corners.end() - 3, out.corners.end());
+  std::sort(patch.begin(), patch.end());
+  EXPECT_EQ(patch, (std::vector<std::uint32_t>{1, 4, 5}));
+  const Channel* uv = out.find("uv", Domain::corner);
+  ASSERT_TRUE(uv);
+  for (std::size_t c = 0; c < out.n_corners(); ++c)
+    for (int k = 0; k < 2; ++k) EXPECT_EQ(uv->as<float>()[2 * c + k], out.positions[out.corners[c]][k] + 2) << c;
+  EXPECT_EQ(test::count_defects(out).non_manifold_edges, test::count_defects(soup).non_manifold_edges);
+}
+
+TEST(FillHoles, HoleAlongANonManifoldEdgeStaysOpen) {
+  // The glued tetrahedra without face (0, 4, 1): the hole's border is 0-4, 4-1 and the glued
+  // edge itself, which keeps three faces. A patch would give it a fourth.
+  Soup soup;
+  soup.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {0, -1, 0}, {0, 0, -1}};
+  for (std::uint32_t c : {0, 2, 1, 0, 1, 3, 1, 2, 3, 2, 0, 3, 0, 1, 5, 1, 4, 5, 4, 0, 5}) soup.corners.push_back(c);
+  soup.face_sizes.assign(7, 3);
+  Mesh mesh = build(soup).mesh;
+  FillHolesReport r = fill_holes(mesh);
+  EXPECT_EQ(r.holes_found, 1u);
+  EXPECT_EQ(r.holes_on_seams, 1u);
+  EXPECT_EQ(r.holes_skipped, 1u);
+  EXPECT_EQ(r.holes_filled, 0u);
+  EXPECT_EQ(r.triangles_added, 0u);
+  ASSERT_EQ(r.messages.size(), 1u);
+  EXPECT_NE(r.messages[0].find("non-manifold"), std::string::npos) << r.messages[0];
+  EXPECT_EQ(extract(mesh).corners, soup.corners);
 }
 
 TEST(FillHoles, DragonRes4AfterRepairOnlyLoneFacesStayOpen) {

@@ -44,9 +44,9 @@ struct FillHolesOptions {
 };
 
 struct FillHolesReport {
-  std::size_t holes_found = 0;  //!< boundary loops before filling
+  std::size_t holes_found = 0;  //!< boundary loops before filling (or stretches of them, see holes_on_seams)
   std::size_t holes_filled = 0;
-  std::size_t holes_skipped = 0;       //!< left open: the four kinds below
+  std::size_t holes_skipped = 0;       //!< left open: the five kinds below
   std::size_t holes_too_large = 0;     //!< more than max_hole_edges edges
   std::size_t holes_not_selected = 0;  //!< with selection_only, a border vertex not selected
   //! the border of a face with no neighbour, or a hole of three edges whose corners have a
@@ -54,6 +54,10 @@ struct FillHolesReport {
   std::size_t lone_faces = 0;
   std::size_t slits = 0;        //!< loops of two edges joining the same two vertices (no triangle fits)
   std::size_t split_seams = 0;  //!< loops along non-manifold edges build() split: not holes, not counted in holes_found
+  //! holes part of whose border is such a split edge (a patch would give it another face).
+  //! Where a loop with split edges holds a stretch of other edges that leaves a vertex and
+  //! comes back to a copy of it, that stretch is a hole of its own and is filled.
+  std::size_t holes_on_seams = 0;
   std::size_t largest_skipped_edges = 0;
   std::size_t triangles_added = 0;
   std::size_t vertices_added = 0;

@@ -5,6 +5,7 @@
 #include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -134,8 +135,9 @@ class HoleFiller {
       }
   }
 
-  //! Fills the hole whose boundary loop holds `start`; `fraction` is the progress so far.
-  void fill(Halfedge start, double fraction);
+  //! Triangulates, refines and fairs f, a face just put on a hole; `fraction` is the
+  //! progress so far.
+  void fill(Face f, double fraction);
 
  private:
   void grow() {
@@ -220,7 +222,7 @@ Vertex HoleFiller::new_vertex(const Vec3d& p, std::span<const Vertex> from) {
   return v;
 }
 
-void HoleFiller::fill(Halfedge start, double fraction) {
+void HoleFiller::fill(Face f, double fraction) {
   fraction_ = fraction;
   loop_.clear();
   border_.clear();
@@ -230,7 +232,7 @@ void HoleFiller::fill(Halfedge start, double fraction) {
   for (ChannelArray& c : corner_values_) c.resize(0);
   grow();
 
-  for (Halfedge b : mesh_.loop(start)) loop_.push_back(b);
+  for (Halfedge b : mesh_.halfedges(f)) loop_.push_back(b);
   for (Halfedge b : loop_) {
     Vertex v = mesh_.from_vertex(b);
     border_.push_back(v);
@@ -242,10 +244,13 @@ void HoleFiller::fill(Halfedge start, double fraction) {
       ++count;
     }
     sigma_[v.idx()] = count ? sum / double(count) : 0;
-    // The corner of v in the face across b (opposite(b) points to v inside that face).
+    // The corner of v in the face across b (opposite(b) points to v inside that face), or
+    // across the side before b where b is the edge that cut a piece off a loop.
+    Halfedge corner = mesh_.opposite(b);
+    if (mesh_.is_boundary(corner)) corner = mesh_.prev(mesh_.opposite(mesh_.prev(b)));
     Index slot = new_slot();
     for (std::size_t k = 0; k < corner_channels_.size(); ++k)
-      std::memcpy(corner_values_[k].element(slot), corner_channels_[k]->element(mesh_.opposite(b).idx()),
+      std::memcpy(corner_values_[k].element(slot), corner_channels_[k]->element(corner.idx()),
                   corner_values_[k].stride());
     slot_[v.idx()] = slot;
   }
@@ -257,7 +262,6 @@ void HoleFiller::fill(Halfedge start, double fraction) {
   mean_sigma /= double(border_.size());
   for (Vertex v : border_) sigma_[v.idx()] = std::max(sigma_[v.idx()], 0.1 * mean_sigma);
 
-  Face f = mesh_.fill_hole(loop_.front());
   add_patch_face(f);
   triangulate(f);
   if (options_.refine) refine();
@@ -671,7 +675,8 @@ void HoleFiller::finish_attributes() {
   TypedArray<bool>* flipped = mesh_.face_properties().get<bool>(provenance::kFlipped);
   std::vector<std::pair<Face, Face>> queue;  // (patch face, face to copy from)
   std::size_t head = 0;
-  for (Halfedge b : loop_) queue.emplace_back(mesh_.face(b), mesh_.face(mesh_.opposite(b)));
+  for (Halfedge b : loop_)
+    if (Face across = mesh_.face(mesh_.opposite(b)); across.is_valid()) queue.emplace_back(mesh_.face(b), across);
   for (Face f : patch_) in_patch_[f.idx()] = 1;
   while (head < queue.size()) {
     auto [f, from] = queue[head++];
@@ -698,6 +703,87 @@ void HoleFiller::finish_attributes() {
   // above; the faces and corners outside the patch are left as they were.
 }
 
+// A hole: `edges` consecutive half-edges of a boundary loop from `start`. Most holes are a
+// whole loop; a piece (cut) is a stretch of a loop that comes back to the input vertex it
+// left, a copy apart in the mesh: its polygon is the stretch's corners, closed by a new
+// edge from the last one to the first that pairs with the stretch's last edge.
+struct Hole {
+  Halfedge start;
+  std::size_t edges;
+  bool cut = false;
+};
+
+std::vector<Halfedge> border_halfedges(const Mesh& mesh, const Hole& hole) {
+  std::vector<Halfedge> border;
+  for (Halfedge b = hole.start; border.size() < hole.edges; b = mesh.next(b)) border.push_back(b);
+  return border;
+}
+
+// The pieces of the loop at `start` (which has split seam edges, and other edges): each
+// stretch of non-seam edges that comes back, welded, to the vertex it left, shortest first.
+// Returns how many non-seam edges no piece takes.
+std::size_t cut_pieces(const Mesh& mesh, Halfedge start, const std::vector<bool>& seam,
+                       const std::vector<std::uint64_t>& welded, std::vector<Hole>& pieces) {
+  std::vector<Halfedge> loop;
+  for (Halfedge b : mesh.loop(start)) loop.push_back(b);
+  auto is_seam = [&](Halfedge b) { return bool(seam[Mesh::edge(b).idx()]); };
+  std::rotate(loop.begin(), std::find_if(loop.begin(), loop.end(), is_seam), loop.end());
+  std::size_t open = 0;
+  std::vector<std::pair<std::uint64_t, std::size_t>> left;  // welded vertex -> position leaving it
+  for (std::size_t k = 0; k < loop.size(); ++k) {
+    const Halfedge b = loop[k];
+    if (is_seam(b)) {
+      left.clear();
+      continue;
+    }
+    ++open;
+    if (left.empty()) left.emplace_back(welded[mesh.from_vertex(b).idx()], k);
+    const std::uint64_t w = welded[mesh.to_vertex(b).idx()];
+    auto back = std::find_if(left.begin(), left.end(), [&](const auto& l) { return l.first == w; });
+    if (back == left.end()) {
+      left.emplace_back(w, k + 1);
+      continue;
+    }
+    const std::size_t edges = k + 1 - back->second;
+    if (edges >= 3 && !mesh.find_halfedge(mesh.from_vertex(b), mesh.from_vertex(loop[back->second])).is_valid()) {
+      pieces.push_back({loop[back->second], edges, true});
+      open -= edges;
+    }
+    left.clear();
+    left.emplace_back(w, k + 1);
+  }
+  return open;
+}
+
+// Whether a triangle on the welded corners of the three-corner piece exists already.
+bool welded_triangle_exists(const Mesh& mesh, const Hole& piece, const std::vector<std::uint64_t>& welded) {
+  std::array<std::uint64_t, 3> corners;
+  std::size_t i = 0;
+  for (Halfedge b : border_halfedges(mesh, piece)) corners[i++] = welded[mesh.from_vertex(b).idx()];
+  std::sort(corners.begin(), corners.end());
+  for (Face f : mesh.faces()) {
+    if (mesh.valence(f) != 3) continue;
+    std::array<std::uint64_t, 3> other;
+    i = 0;
+    for (Vertex v : mesh.vertices(f)) other[i++] = welded[v.idx()];
+    std::sort(other.begin(), other.end());
+    if (other == corners) return true;
+  }
+  return false;
+}
+
+// Puts one face on a piece: a face over its whole loop, split by the edge from the piece's
+// last corner to its first, and the rest of the loop opened again.
+Face cut_off(Mesh& mesh, const Hole& piece) {
+  Halfedge last = piece.start;
+  for (std::size_t i = 2; i < piece.edges; ++i) last = mesh.next(last);
+  const Halfedge before = mesh.prev(piece.start);
+  mesh.fill_hole(piece.start);
+  const Halfedge closing = mesh.insert_edge(last, before);
+  mesh.delete_face(mesh.face(Mesh::opposite(closing)));
+  return mesh.face(closing);
+}
+
 }  // namespace
 
 FillHolesReport fill_holes(Mesh& input, const FillHolesOptions& options, Progress& progress) {
@@ -705,10 +791,6 @@ FillHolesReport fill_holes(Mesh& input, const FillHolesOptions& options, Progres
   progress.update(0, "finding holes");
 
   // Find the boundary loops first: filling one never changes another.
-  struct Hole {
-    Halfedge start;
-    std::size_t edges;
-  };
   std::vector<Hole> holes;
   {
     std::vector<char> seen(input.halfedges_size(), 0);
@@ -723,25 +805,36 @@ FillHolesReport fill_holes(Mesh& input, const FillHolesOptions& options, Progres
     }
   }
   // Loops along edges that build() split apart (non-manifold input) are no holes: in the
-  // input the surface goes on across every one of their edges.
+  // input the surface goes on across every one of their edges. Where a loop has such edges
+  // and others, its holes are the stretches of the others that come back to the input
+  // vertex they left; what is left of it stays open, since a patch would give the split
+  // edges another face.
   const std::vector<bool> seam = split_seam_edges(input);
+  const std::vector<std::uint64_t> welded = welded_vertex_ids(input);
+  std::vector<Hole> pieces;
   if (!seam.empty())
     std::erase_if(holes, [&](const Hole& hole) {
-      for (Halfedge b : input.loop(hole.start))
-        if (!seam[Mesh::edge(b).idx()]) return false;
-      ++report.split_seams;
+      std::size_t seams = 0;
+      for (Halfedge b : input.loop(hole.start)) seams += seam[Mesh::edge(b).idx()];
+      if (seams == 0) return false;
+      if (seams == hole.edges)
+        ++report.split_seams;
+      else if (cut_pieces(input, hole.start, seam, welded, pieces))
+        ++report.holes_on_seams;
       return true;
     });
-  report.holes_found = holes.size();
+  holes.insert(holes.end(), pieces.begin(), pieces.end());
+  report.holes_found = holes.size() + report.holes_on_seams;
 
   std::vector<Hole> to_fill;
   std::size_t total_edges = 0;
   const std::vector<std::uint8_t> selected =
       options.selection_only ? detail::selected_vertices(input) : std::vector<std::uint8_t>();
   for (const Hole& hole : holes) {
+    const std::vector<Halfedge> border = border_halfedges(input, hole);
     if (!selected.empty()) {
       bool all = true;
-      for (Halfedge b : input.loop(hole.start)) all = all && selected[input.to_vertex(b).idx()];
+      for (Halfedge b : border) all = all && selected[input.from_vertex(b).idx()];
       if (!all) {
         ++report.holes_not_selected;
         continue;
@@ -759,16 +852,19 @@ FillHolesReport fill_holes(Mesh& input, const FillHolesOptions& options, Progres
     // The border of a lone polygon: filling it would only add the same face backwards.
     Face only = input.face(Mesh::opposite(hole.start));
     bool lone = true;
-    for (Halfedge b : input.loop(hole.start))
+    for (Halfedge b : border)
       if (input.face(Mesh::opposite(b)) != only) lone = false;
-    if (lone || (hole.edges == 3 && triangle_exists(input, hole.start))) {
+    const bool doubled = hole.edges == 3 &&
+                         (hole.cut ? welded_triangle_exists(input, hole, welded) : triangle_exists(input, hole.start));
+    if (lone || doubled) {
       ++report.lone_faces;
       continue;
     }
     to_fill.push_back(hole);
     total_edges += hole.edges;
   }
-  report.holes_skipped = report.holes_too_large + report.lone_faces + report.slits + report.holes_not_selected;
+  report.holes_skipped =
+      report.holes_too_large + report.lone_faces + report.slits + report.holes_not_selected + report.holes_on_seams;
   if (report.holes_too_large)
     report.messages.push_back(std::to_string(report.holes_too_large) + " holes with more than " +
                               std::to_string(options.max_hole_edges) + " edges left open (the largest has " +
@@ -781,6 +877,10 @@ FillHolesReport fill_holes(Mesh& input, const FillHolesOptions& options, Progres
     report.messages.push_back(std::to_string(report.split_seams) +
                               " boundary loops along non-manifold edges left open (the input's surface is "
                               "closed there; building split the edges to work on them)");
+  if (report.holes_on_seams)
+    report.messages.push_back(std::to_string(report.holes_on_seams) +
+                              " holes left open whose border runs in part along non-manifold edges (building "
+                              "split them apart): a patch would give those edges another face");
   if (report.slits)
     report.messages.push_back(std::to_string(report.slits) +
                               " holes of two edges left open (no triangle fits them; repair removes them)");
@@ -794,12 +894,13 @@ FillHolesReport fill_holes(Mesh& input, const FillHolesOptions& options, Progres
   for (const Hole& hole : to_fill) {
     const double fraction = double(done_edges) / double(total_edges);
     progress.update(fraction, "filling holes");
-    filler.fill(hole.start, fraction);
+    filler.fill(hole.cut ? cut_off(mesh, hole) : mesh.fill_hole(hole.start), fraction);
     done_edges += hole.edges;
     ++report.holes_filled;
   }
   report.vertices_added = mesh.n_vertices() - vertices_before;
   report.triangles_added = mesh.n_faces() - faces_before;
+  if (mesh.has_garbage()) mesh.compact();  // the faces cut_off() opened again
   if (report.fairing_failures)
     report.messages.push_back(std::to_string(report.fairing_failures) +
                               " patches could not be faired (singular system) and keep their refined shape");
@@ -844,6 +945,7 @@ Operation fill_holes_operation() {
               })
       .result(&R::lone_faces, "lone_faces_left_open")
       .result(&R::slits, "two_edge_slits_left_open")
+      .result(&R::holes_on_seams, "holes_on_non_manifold_edges_left_open")
       .result(&R::split_seams, "non_manifold_seams_left_open")
       .result(&R::triangles_added, "triangles_added")
       .result(&R::vertices_added, "vertices_added")
