@@ -13,6 +13,7 @@
 #include <limits>
 #include <numbers>
 #include <span>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -729,7 +730,7 @@ std::size_t cut_pieces(const Mesh& mesh, Halfedge start, const std::vector<bool>
   auto is_seam = [&](Halfedge b) { return bool(seam[Mesh::edge(b).idx()]); };
   std::rotate(loop.begin(), std::find_if(loop.begin(), loop.end(), is_seam), loop.end());
   std::size_t open = 0;
-  std::vector<std::pair<std::uint64_t, std::size_t>> left;  // welded vertex -> position leaving it
+  std::unordered_map<std::uint64_t, std::size_t> left;  // welded vertex -> position leaving it
   for (std::size_t k = 0; k < loop.size(); ++k) {
     const Halfedge b = loop[k];
     if (is_seam(b)) {
@@ -737,39 +738,34 @@ std::size_t cut_pieces(const Mesh& mesh, Halfedge start, const std::vector<bool>
       continue;
     }
     ++open;
-    if (left.empty()) left.emplace_back(welded[mesh.from_vertex(b).idx()], k);
+    if (left.empty()) left.emplace(welded[mesh.from_vertex(b).idx()], k);
     const std::uint64_t w = welded[mesh.to_vertex(b).idx()];
-    auto back = std::find_if(left.begin(), left.end(), [&](const auto& l) { return l.first == w; });
-    if (back == left.end()) {
-      left.emplace_back(w, k + 1);
-      continue;
-    }
-    const std::size_t edges = k + 1 - back->second;
-    if (edges >= 3 && !mesh.find_halfedge(mesh.from_vertex(b), mesh.from_vertex(loop[back->second])).is_valid()) {
-      pieces.push_back({loop[back->second], edges, true});
+    const auto [back, first_visit] = left.emplace(w, k + 1);
+    if (first_visit) continue;
+    const std::size_t a = back->second, edges = k + 1 - a;
+    if (edges >= 3 && !mesh.find_halfedge(mesh.from_vertex(b), mesh.from_vertex(loop[a])).is_valid()) {
+      pieces.push_back({loop[a], edges, true});
       open -= edges;
     }
     left.clear();
-    left.emplace_back(w, k + 1);
+    left.emplace(w, k + 1);
   }
   return open;
 }
 
-// Whether a triangle on the welded corners of the three-corner piece exists already.
-bool welded_triangle_exists(const Mesh& mesh, const Hole& piece, const std::vector<std::uint64_t>& welded) {
-  std::array<std::uint64_t, 3> corners;
-  std::size_t i = 0;
-  for (Halfedge b : border_halfedges(mesh, piece)) corners[i++] = welded[mesh.from_vertex(b).idx()];
-  std::sort(corners.begin(), corners.end());
+// The triangles of `mesh` by their welded corners (each sorted), in order.
+std::vector<std::array<std::uint64_t, 3>> welded_triangles(const Mesh& mesh, const std::vector<std::uint64_t>& welded) {
+  std::vector<std::array<std::uint64_t, 3>> triangles;
   for (Face f : mesh.faces()) {
     if (mesh.valence(f) != 3) continue;
-    std::array<std::uint64_t, 3> other;
-    i = 0;
-    for (Vertex v : mesh.vertices(f)) other[i++] = welded[v.idx()];
-    std::sort(other.begin(), other.end());
-    if (other == corners) return true;
+    std::array<std::uint64_t, 3> t;
+    std::size_t i = 0;
+    for (Vertex v : mesh.vertices(f)) t[i++] = welded[v.idx()];
+    std::sort(t.begin(), t.end());
+    triangles.push_back(t);
   }
-  return false;
+  std::sort(triangles.begin(), triangles.end());
+  return triangles;
 }
 
 // Puts one face on a piece: a face over its whole loop, split by the edge from the piece's
@@ -830,6 +826,7 @@ FillHolesReport fill_holes(Mesh& input, const FillHolesOptions& options, Progres
   std::size_t total_edges = 0;
   const std::vector<std::uint8_t> selected =
       options.selection_only ? detail::selected_vertices(input) : std::vector<std::uint8_t>();
+  std::vector<std::array<std::uint64_t, 3>> triangles;  // welded_triangles(), once a piece needs them
   for (const Hole& hole : holes) {
     const std::vector<Halfedge> border = border_halfedges(input, hole);
     if (!selected.empty()) {
@@ -854,8 +851,15 @@ FillHolesReport fill_holes(Mesh& input, const FillHolesOptions& options, Progres
     bool lone = true;
     for (Halfedge b : border)
       if (input.face(Mesh::opposite(b)) != only) lone = false;
-    const bool doubled = hole.edges == 3 &&
-                         (hole.cut ? welded_triangle_exists(input, hole, welded) : triangle_exists(input, hole.start));
+    bool doubled = false;
+    if (hole.edges == 3 && !hole.cut) doubled = triangle_exists(input, hole.start);
+    if (hole.edges == 3 && hole.cut) {  // the same test through the weld
+      if (triangles.empty()) triangles = welded_triangles(input, welded);
+      std::array<std::uint64_t, 3> t;
+      for (std::size_t i = 0; i < 3; ++i) t[i] = welded[input.from_vertex(border[i]).idx()];
+      std::sort(t.begin(), t.end());
+      doubled = std::binary_search(triangles.begin(), triangles.end(), t);
+    }
     if (lone || doubled) {
       ++report.lone_faces;
       continue;
