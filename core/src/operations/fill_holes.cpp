@@ -753,16 +753,23 @@ std::size_t cut_pieces(const Mesh& mesh, Halfedge start, const std::vector<bool>
   return open;
 }
 
+using WeldedTriangle = std::array<std::uint64_t, 3>;
+
+// The welded ids of three vertices, sorted: the same triangle whichever copies it joins.
+WeldedTriangle welded_triangle(const std::vector<std::uint64_t>& welded, Vertex a, Vertex b, Vertex c) {
+  WeldedTriangle t{welded[a.idx()], welded[b.idx()], welded[c.idx()]};
+  std::sort(t.begin(), t.end());
+  return t;
+}
+
 // The triangles of `mesh` by their welded corners (each sorted), in order.
-std::vector<std::array<std::uint64_t, 3>> welded_triangles(const Mesh& mesh, const std::vector<std::uint64_t>& welded) {
-  std::vector<std::array<std::uint64_t, 3>> triangles;
+std::vector<WeldedTriangle> welded_triangles(const Mesh& mesh, const std::vector<std::uint64_t>& welded) {
+  std::vector<WeldedTriangle> triangles;
   for (Face f : mesh.faces()) {
     if (mesh.valence(f) != 3) continue;
-    std::array<std::uint64_t, 3> t;
-    std::size_t i = 0;
-    for (Vertex v : mesh.vertices(f)) t[i++] = welded[v.idx()];
-    std::sort(t.begin(), t.end());
-    triangles.push_back(t);
+    const Halfedge h = mesh.halfedge(f);
+    triangles.push_back(
+        welded_triangle(welded, mesh.to_vertex(h), mesh.to_vertex(mesh.next(h)), mesh.to_vertex(mesh.prev(h))));
   }
   std::sort(triangles.begin(), triangles.end());
   return triangles;
@@ -826,7 +833,7 @@ FillHolesReport fill_holes(Mesh& input, const FillHolesOptions& options, Progres
   std::size_t total_edges = 0;
   const std::vector<std::uint8_t> selected =
       options.selection_only ? detail::selected_vertices(input) : std::vector<std::uint8_t>();
-  std::vector<std::array<std::uint64_t, 3>> triangles;  // welded_triangles(), once a piece needs them
+  std::vector<WeldedTriangle> triangles;  // welded_triangles(), once a piece needs them
   for (const Hole& hole : holes) {
     const std::vector<Halfedge> border = border_halfedges(input, hole);
     if (!selected.empty()) {
@@ -855,9 +862,8 @@ FillHolesReport fill_holes(Mesh& input, const FillHolesOptions& options, Progres
     if (hole.edges == 3 && !hole.cut) doubled = triangle_exists(input, hole.start);
     if (hole.edges == 3 && hole.cut) {  // the same test through the weld
       if (triangles.empty()) triangles = welded_triangles(input, welded);
-      std::array<std::uint64_t, 3> t;
-      for (std::size_t i = 0; i < 3; ++i) t[i] = welded[input.from_vertex(border[i]).idx()];
-      std::sort(t.begin(), t.end());
+      const WeldedTriangle t = welded_triangle(welded, input.from_vertex(border[0]), input.from_vertex(border[1]),
+                                               input.from_vertex(border[2]));
       doubled = std::binary_search(triangles.begin(), triangles.end(), t);
     }
     if (lone || doubled) {
