@@ -3,6 +3,7 @@
 #include "hedge/io.h"
 
 #include <fcntl.h>
+#include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -13,6 +14,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <string>
+#include <string_view>
 
 #include "hedge/error.h"
 #include "io_detail.h"
@@ -109,6 +111,63 @@ std::string lower(std::string s) {
 
 std::string system_reason(int error) { return std::strerror(error); }
 
+//! A file's bytes: mapped from the page cache when it is a regular file, read into memory
+//! otherwise (pipes and special files). Mapping spares a copy of the whole file into fresh
+//! pages, which on the dragon's 34 MB were a fifth of a decimation's page faults.
+class FileBytes {
+ public:
+  explicit FileBytes(const std::string& path) {
+    int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) fail(path, errno);
+    struct stat info {};
+    if (::fstat(fd, &info) == 0 && S_ISREG(info.st_mode) && info.st_size > 0) {
+      auto size = static_cast<std::size_t>(info.st_size);
+      void* p = ::mmap(nullptr, size, PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0);
+      if (p != MAP_FAILED) {
+        ::close(fd);
+        mapped_ = p;
+        size_ = size;
+        return;
+      }
+    }
+    read_all(path, fd);
+  }
+  FileBytes(const FileBytes&) = delete;
+  FileBytes& operator=(const FileBytes&) = delete;
+  ~FileBytes() {
+    if (mapped_) ::munmap(mapped_, size_);
+  }
+
+  std::string_view view() const {
+    return mapped_ ? std::string_view(static_cast<const char*>(mapped_), size_) : std::string_view(copy_);
+  }
+
+ private:
+  [[noreturn]] static void fail(const std::string& path, int error) {
+    throw Error("cannot open " + path + ": " + system_reason(error));
+  }
+
+  void read_all(const std::string& path, int fd) {
+    char buffer[1 << 16];
+    for (;;) {
+      ssize_t n = ::read(fd, buffer, sizeof buffer);
+      if (n < 0 && errno == EINTR) continue;
+      if (n < 0) {
+        int error = errno;
+        ::close(fd);
+        fail(path, error);
+      }
+      if (n == 0) break;
+      copy_.append(buffer, static_cast<std::size_t>(n));
+    }
+    ::close(fd);
+  }
+
+  void* mapped_ = nullptr;
+  std::size_t size_ = 0;
+  std::string copy_;
+};
+
 }  // namespace
 
 FileFormat format_from_path(const std::string& path) {
@@ -126,24 +185,8 @@ FileFormat format_from_path(const std::string& path) {
 
 Soup read_mesh(const std::string& path) {
   FileFormat format = format_from_path(path);
-  std::FILE* file = std::fopen(path.c_str(), "rb");
-  if (!file) throw Error("cannot open " + path + ": " + system_reason(errno));
-  std::string bytes;
-  // Read in large blocks rather than trusting a size from stat, which pipes and some
-  // special files do not have.
-  struct stat info {};
-  if (::fstat(fileno(file), &info) == 0 && S_ISREG(info.st_mode) && info.st_size > 0)
-    bytes.reserve(static_cast<std::size_t>(info.st_size));
-  char buffer[1 << 16];
-  for (;;) {
-    std::size_t n = std::fread(buffer, 1, sizeof buffer, file);
-    bytes.append(buffer, n);
-    if (n < sizeof buffer) break;
-  }
-  bool failed = std::ferror(file);
-  int error = errno;
-  std::fclose(file);
-  if (failed) throw Error("cannot open " + path + ": " + system_reason(error));
+  FileBytes file(path);
+  std::string_view bytes = file.view();
   switch (format) {
     case FileFormat::off:
       return read_off(bytes, path);

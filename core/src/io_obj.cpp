@@ -24,7 +24,7 @@ struct Reference {  // a vt or vn index that pointed past what the file had defi
 
 class ObjReader {
  public:
-  ObjReader(const std::string& bytes, const std::string& name) : in_(bytes, name, '#', true), name_(name) {}
+  ObjReader(std::string_view bytes, const std::string& name) : in_(bytes, name, '#', true), name_(name) {}
 
   Soup read() {
     for (;;) {
@@ -245,7 +245,7 @@ class Dedup {
 
 }  // namespace
 
-Soup read_obj(const std::string& bytes, const std::string& name) { return ObjReader(bytes, name).read(); }
+Soup read_obj(std::string_view bytes, const std::string& name) { return ObjReader(bytes, name).read(); }
 
 std::string write_obj(const Soup& soup) {
   soup.check();

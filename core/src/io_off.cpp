@@ -70,7 +70,7 @@ constexpr std::size_t kMaxLineTokens = 64;
 
 }  // namespace
 
-Soup read_off(const std::string& bytes, const std::string& name) {
+Soup read_off(std::string_view bytes, const std::string& name) {
   TextScanner in(bytes, name, '#');
   Soup soup;
 

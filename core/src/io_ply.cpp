@@ -128,7 +128,7 @@ std::vector<std::string_view> split(std::string_view line) {
   return words;
 }
 
-Header parse_header(const std::string& bytes, const std::string& name) {
+Header parse_header(std::string_view bytes, const std::string& name) {
   Header header;
   std::size_t pos = 0;
   std::size_t line_number = 0;
@@ -140,8 +140,8 @@ Header parse_header(const std::string& bytes, const std::string& name) {
       fail_line(name, line_number, "the header ends without 'end_header'");
     }
     std::size_t nl = bytes.find('\n', pos);
-    std::string_view line(bytes.data() + pos, (nl == std::string::npos ? bytes.size() : nl) - pos);
-    pos = nl == std::string::npos ? bytes.size() : nl + 1;
+    std::string_view line(bytes.data() + pos, (nl == std::string_view::npos ? bytes.size() : nl) - pos);
+    pos = nl == std::string_view::npos ? bytes.size() : nl + 1;
     while (!line.empty() && (line.back() == '\r' || line.back() == ' ' || line.back() == '\t')) line.remove_suffix(1);
     auto fail = [&](const std::string& what) { fail_line(name, line_number, what); };
 
@@ -308,8 +308,8 @@ struct Place {
 
 class AsciiSource {
  public:
-  AsciiSource(const std::string& bytes, const Header& header, const std::string& name, const Place& place)
-      : in_(std::string_view(bytes).substr(header.body), name), place_(place), line_offset_(header.body_line - 1) {}
+  AsciiSource(std::string_view bytes, const Header& header, const std::string& name, const Place& place)
+      : in_(bytes.substr(header.body), name), place_(place), line_offset_(header.body_line - 1) {}
 
   double number(PlyType t) {
     std::string_view token = next(t);
@@ -384,7 +384,7 @@ class AsciiSource {
 template <bool BigEndian>
 class BinarySource {
  public:
-  BinarySource(const std::string& bytes, const Header& header, const std::string& name, const Place& place)
+  BinarySource(std::string_view bytes, const Header& header, const std::string& name, const Place& place)
       : begin_(reinterpret_cast<const unsigned char*>(bytes.data())),
         p_(begin_ + header.body),
         end_(begin_ + bytes.size()),
@@ -556,7 +556,7 @@ void read_body(Source& in, Header& header, Place& place, Sink& sink) {
 
 }  // namespace
 
-Soup read_ply(const std::string& bytes, const std::string& name) {
+Soup read_ply(std::string_view bytes, const std::string& name) {
   Header header = parse_header(bytes, name);
   assign_targets(header, name);
   const std::size_t body_bytes = bytes.size() - header.body;

@@ -74,7 +74,7 @@ void weld(const std::vector<Point>& raw, Soup& soup) {
   }
 }
 
-Soup read_binary(const std::string& bytes, std::uint32_t triangles, const std::string& name) {
+Soup read_binary(std::string_view bytes, std::uint32_t triangles, const std::string& name) {
   if (triangles > kMaxFaces) fail_byte(name, 80, limit_message(triangles, kMaxFaces, "triangles"));
   const auto* p = reinterpret_cast<const unsigned char*>(bytes.data()) + kHeaderBytes;
   std::vector<Point> raw(3 * std::size_t{triangles});
@@ -88,7 +88,7 @@ Soup read_binary(const std::string& bytes, std::uint32_t triangles, const std::s
   return soup;
 }
 
-Soup read_ascii(const std::string& bytes, const std::string& name) {
+Soup read_ascii(std::string_view bytes, const std::string& name) {
   TextScanner in(bytes, name);
   auto expect = [&](const char* keyword) {
     std::string_view t = in.token();
@@ -148,16 +148,16 @@ Soup read_ascii(const std::string& bytes, const std::string& name) {
   return soup;
 }
 
-bool starts_with_solid(const std::string& bytes) {
+bool starts_with_solid(std::string_view bytes) {
   std::size_t i = 0;
   while (i < bytes.size() && (bytes[i] == ' ' || bytes[i] == '\t' || bytes[i] == '\r' || bytes[i] == '\n')) ++i;
-  if (!iequal(std::string_view(bytes).substr(i, 5), "solid")) return false;
+  if (!iequal(bytes.substr(i, 5), "solid")) return false;
   return i + 5 == bytes.size() || std::isspace(static_cast<unsigned char>(bytes[i + 5]));
 }
 
 }  // namespace
 
-Soup read_stl(const std::string& bytes, const std::string& name) {
+Soup read_stl(std::string_view bytes, const std::string& name) {
   const std::size_t size = bytes.size();
   std::uint64_t triangles = 0, needed = 0;
   if (size >= kHeaderBytes) {

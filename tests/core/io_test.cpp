@@ -4,6 +4,7 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -16,8 +17,10 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <iterator>
 #include <random>
 #include <string>
+#include <thread>
 #include <tuple>
 #include <vector>
 
@@ -98,7 +101,7 @@ void put(std::string& out, T v, bool big_endian = false) {
 }
 
 //! Every prefix of `bytes` must either read or throw hedge::Error (never crash or hang).
-void read_every_truncation(const std::string& bytes, Soup (*reader)(const std::string&, const std::string&)) {
+void read_every_truncation(const std::string& bytes, Soup (*reader)(std::string_view, const std::string&)) {
   std::size_t errors = 0;
   for (std::size_t n = 0; n <= bytes.size(); ++n) {
     try {
@@ -166,6 +169,26 @@ TEST(IoFiles, WriteAndReadThroughFiles) {
     ++files;
   }
   EXPECT_EQ(files, 4u);
+  std::filesystem::remove_all(dir);
+}
+
+// Regular files are mapped; pipes and empty files are read the other way, with the same result.
+TEST(IoFiles, ReadsPipesAndEmptyFiles) {
+  std::string dir = temp_dir();
+  write_mesh(sample_soup(), dir + "/mesh.ply");
+  std::string bytes;
+  {
+    std::ifstream in(dir + "/mesh.ply", std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  std::string fifo = dir + "/pipe.ply";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  std::thread writer([&] { std::ofstream(fifo, std::ios::binary) << bytes; });
+  Soup piped = read_mesh(fifo);
+  writer.join();
+  expect_same(piped, sample_soup());
+  { std::ofstream(dir + "/empty.off"); }
+  EXPECT_THAT(error_of([&] { read_mesh(dir + "/empty.off"); }), HasSubstr(dir + "/empty.off"));
   std::filesystem::remove_all(dir);
 }
 
@@ -870,7 +893,7 @@ TEST(IoGarbage, TextTruncations) {
 }
 
 TEST(IoGarbage, RandomBytesAndMutations) {
-  Soup (*readers[])(const std::string&, const std::string&) = {read_off, read_obj, read_ply, read_stl};
+  Soup (*readers[])(std::string_view, const std::string&) = {read_off, read_obj, read_ply, read_stl};
   std::vector<std::string> seeds = {write_off(soup_with_all_ply_channels()),
                                     write_obj(soup_with_all_ply_channels()),
                                     write_ply(soup_with_all_ply_channels(), true),

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <string>
+#include <string_view>
 
 #include "hedge/soup.h"
 
@@ -22,10 +23,10 @@ Soup read_mesh(const std::string& path);
 void write_mesh(const Soup& soup, const std::string& path, const WriteOptions& options = {});
 
 // Per format, from/to memory; `name` is used in error messages.
-Soup read_off(const std::string& bytes, const std::string& name);
-Soup read_obj(const std::string& bytes, const std::string& name);
-Soup read_ply(const std::string& bytes, const std::string& name);
-Soup read_stl(const std::string& bytes, const std::string& name);
+Soup read_off(std::string_view bytes, const std::string& name);
+Soup read_obj(std::string_view bytes, const std::string& name);
+Soup read_ply(std::string_view bytes, const std::string& name);
+Soup read_stl(std::string_view bytes, const std::string& name);
 std::string write_off(const Soup& soup);
 std::string write_obj(const Soup& soup);
 std::string write_ply(const Soup& soup, bool binary);
