@@ -179,22 +179,24 @@ def read_mesh(me, edges=True):
     builtin = builtin_attributes()
     loop_start = _get(me.polygons, "loop_start", nf, np.int32)
     loop_total = np.diff(np.append(loop_start, np.int32(nl))).astype(np.int32)
-    if nf and not (loop_start[0] == 0 and np.all(loop_total > 0)):
-        # Loops not in polygon order (possible before 3.6): their sizes are read.
+    # Starts rising from 0 are the loops in polygon order, each polygon's size the gap to the
+    # next start; otherwise (possible before 3.6) the sizes are read and the order checked.
+    in_order = not nf or (loop_start[0] == 0 and np.all(loop_total > 0))
+    if not in_order:
         loop_total = _get(me.polygons, "loop_total", nf, np.int32)
     if ".corner_vert" in builtin:
         vertex_index = _builtin(me, ".corner_vert", nl, np.int32, 0)
     else:
         vertex_index = _get(me.loops, "vertex_index", nl, np.int32)
-    starts = np.zeros(nf, np.int64)
-    if nf:
+    corners = vertex_index
+    if not in_order:
+        starts = np.zeros(nf, np.int64)
         np.cumsum(loop_total[:-1], out=starts[1:])
-    if nf and not np.array_equal(starts, loop_start):
-        # Loops not stored in polygon order: corner k of polygon f is loop loop_start[f] + k.
-        d.loop_order = (np.repeat(loop_start - starts, loop_total) + np.arange(int(loop_total.sum()))).astype(np.int64)
-        corners = vertex_index[d.loop_order]
-    else:
-        corners = vertex_index
+        if not np.array_equal(starts, loop_start):
+            # Loops not stored in polygon order: corner k of polygon f is loop loop_start[f] + k.
+            d.loop_order = (np.repeat(loop_start - starts, loop_total) +
+                            np.arange(int(loop_total.sum()))).astype(np.int64)
+            corners = vertex_index[d.loop_order]
     channels = []
 
     def corner_values(values):

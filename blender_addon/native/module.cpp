@@ -132,8 +132,9 @@ Soup soup_from(const py::dict& mesh) {
     py::array a = contiguous(mesh[key]);
     if (!a || (a.dtype().kind() != 'i' && a.dtype().kind() != 'u') || a.itemsize() != 4)
       throw Error(std::string(key) + " must be int32 or uint32");
-    out.resize(static_cast<std::size_t>(a.size()));
-    if (a.size()) std::memcpy(out.data(), a.data(), static_cast<std::size_t>(a.nbytes()));
+    // assign() copies once; resize() then memcpy would write every element twice.
+    const auto* first = static_cast<const std::uint32_t*>(a.data());
+    out.assign(first, first + a.size());
   };
   indices("face_sizes", soup.face_sizes);
   indices("corners", soup.corners);
@@ -150,8 +151,8 @@ Soup soup_from(const py::dict& mesh) {
       c.components = a.ndim() >= 2 ? static_cast<int>(a.size() / std::max<py::ssize_t>(a.shape(0), 1))
                                    : (n ? static_cast<int>(static_cast<std::size_t>(a.size()) / n) : 1);
       if (c.components < 1) c.components = 1;
-      c.data.resize(static_cast<std::size_t>(a.nbytes()));
-      if (a.nbytes()) std::memcpy(c.data.data(), a.data(), c.data.size());
+      const auto* first = static_cast<const std::byte*>(a.data());
+      c.data.assign(first, first + a.nbytes());
       soup.channels.push_back(std::move(c));
     }
   }
