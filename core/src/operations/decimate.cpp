@@ -660,7 +660,10 @@ void Decimator::compute_quadrics() {
   parallel_for(n, opt_.threads, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
       vd_[i] = VertexData();
-      if (const Vertex v(static_cast<Index>(i)); !m_.is_deleted(v)) vd_[i].position = to_float(local(v));
+      const Vertex v(static_cast<Index>(i));
+      if (m_.is_deleted(v)) continue;
+      vd_[i].position = to_float(local(v));
+      if (m_.is_isolated(v)) vd_[i].flags = kBoundary;  // as Mesh::is_boundary() says
     }
   });
   // Each vertex sums the planes of its own faces and boundary edges, around its ring: the
@@ -679,7 +682,9 @@ void Decimator::compute_quadrics() {
           v, [&](Vertex w) { return at(w); }, &seen);
       vd_[i].valence =
           static_cast<std::uint16_t>(std::min<std::size_t>(seen.valence, std::numeric_limits<std::uint16_t>::max()));
-      if (seen.hole) boundary |= add_boundary_planes(v, q);
+      // A gap between its faces: the vertex is on the boundary (its outgoing half-edge lies
+      // on it), found here rather than by another pass through every vertex's half-edge.
+      if (seen.hole) vd_[i].flags = kBoundary, boundary |= add_boundary_planes(v, q);
       // A weight scales every plane of the vertex, and so its share of a merged quadric: the
       // cost rises where detail matters while cost / weight stays a mean squared distance.
       if (!weight_factor_.empty()) q *= weight_factor_[i];
@@ -829,12 +834,14 @@ std::uint8_t Decimator::classify(Vertex v) const {
   return kOnSeam | kLockedSeam;
 }
 
+// The boundary flags come from compute_quadrics(); the seam and lock flags are added here.
 void Decimator::classify_vertices() {
+  if (!seam_mode_ && inside_selection_.empty() && lock_.empty()) return;
   parallel_for(m_.vertices_size(), opt_.threads, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
       const Vertex v(static_cast<Index>(i));
       if (m_.is_deleted(v)) continue;
-      std::uint8_t f = m_.is_boundary(v) ? kBoundary : 0;
+      std::uint8_t f = vd_[i].flags & kBoundary;
       if (seam_mode_) f |= classify(v);
       if (!inside_selection_.empty() && !inside_selection_[i]) f |= kLocked;
       if (!lock_.empty() && lock_[i] != 0) f |= kLocked;
