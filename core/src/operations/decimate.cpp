@@ -219,6 +219,7 @@ class EdgeQueue {
   std::size_t size() const { return size_; }
   void clear() {
     for (auto& b : buckets_) b.clear();
+    occupied_ = 0;
     size_ = 0;
     last_ = 0;
   }
@@ -228,42 +229,46 @@ class EdgeQueue {
       k = (last_ & ~0xffu) | (k & 0xffu);
       if (k < last_) k += 0x100;
     }
-    buckets_[bucket(k)].push_back({k, edge});
+    put({k, edge});
     ++size_;
   }
   //! The edge pop() will return next unless a lower key is pushed first, or kInvalidIndex
   //! when that is not cheap to tell: a guess, for fetching its data ahead.
   Index peek() const {
-    if (!buckets_[0].empty()) return buckets_[0].back().edge;
-    for (int i = 1; i < 33; ++i) {
-      if (buckets_[i].empty()) continue;
-      if (buckets_[i].size() > 8) return kInvalidIndex;
-      const Entry* best = nullptr;
-      for (const Entry& e : buckets_[i])
-        if ((*versions_)[e.edge] == version(e.key) && (!best || e.key < best->key)) best = &e;
-      return best ? best->edge : kInvalidIndex;
-    }
-    return kInvalidIndex;
+    if (occupied_ & 1) return buckets_[0].back().edge;
+    if (occupied_ == 0) return kInvalidIndex;
+    const std::vector<Entry>& first = buckets_[std::countr_zero(occupied_)];
+    if (first.size() > 8) return kInvalidIndex;
+    const Entry* best = nullptr;
+    for (const Entry& e : first)
+      if ((*versions_)[e.edge] == version(e.key) && (!best || e.key < best->key)) best = &e;
+    return best ? best->edge : kInvalidIndex;
   }
   //! Takes the entry of least key, or an entry with a stale version; precondition: !empty().
   Entry pop() {
-    if (buckets_[0].empty()) refill();
-    if (buckets_[0].empty()) return {0, kInvalidIndex};  // only stale entries were left
+    if (!(occupied_ & 1)) refill();
+    if (!(occupied_ & 1)) return {0, kInvalidIndex};  // only stale entries were left
     const Entry e = buckets_[0].back();
     buckets_[0].pop_back();
+    if (buckets_[0].empty()) occupied_ &= ~std::uint64_t(1);
     --size_;
     return e;
   }
 
  private:
   int bucket(std::uint32_t k) const { return k == last_ ? 0 : 32 - std::countl_zero(k ^ last_); }
+  void put(const Entry& e) {
+    const int b = bucket(e.key);
+    buckets_[b].push_back(e);
+    occupied_ |= std::uint64_t(1) << b;
+  }
   // Stale entries are dropped on the way (most entries are: every collapse re-queues the
   // edges around the kept vertex), so they are not moved down bucket after bucket.
   void refill() {
     for (;;) {
-      int i = 1;
-      while (i < 33 && buckets_[i].empty()) ++i;
-      if (i == 33) return;
+      if (occupied_ == 0) return;
+      const int i = std::countr_zero(occupied_);  // bucket 0 is empty
+      occupied_ &= ~(std::uint64_t(1) << i);      // its entries all move to lower buckets
       std::vector<Entry>& from = buckets_[i];
       std::size_t live = 0;
       // The versions of a bucket's edges are scattered over the array: fetch them ahead.
@@ -279,13 +284,14 @@ class EdgeQueue {
       std::uint32_t least = from.front().key;
       for (const Entry& e : from) least = std::min(least, e.key);
       last_ = least;
-      for (const Entry& e : from) buckets_[bucket(e.key)].push_back(e);
+      for (const Entry& e : from) put(e);
       from.clear();
       return;
     }
   }
   const std::vector<std::uint8_t>* versions_;
   std::vector<Entry> buckets_[33];
+  std::uint64_t occupied_ = 0;  // bit i: buckets_[i] holds entries
   std::uint32_t last_ = 0;
   std::size_t size_ = 0;
 };
