@@ -690,7 +690,10 @@ void Decimator::compute_quadrics() {
           static_cast<std::uint16_t>(std::min<std::size_t>(seen.valence, std::numeric_limits<std::uint16_t>::max()));
       // A gap between its faces: the vertex is on the boundary (its outgoing half-edge lies
       // on it), found here rather than by another pass through every vertex's half-edge.
-      if (seen.hole) vd_[i].flags = kBoundary, boundary |= add_boundary_planes(v, q);
+      if (seen.hole) {
+        vd_[i].flags = kBoundary;
+        boundary |= add_boundary_planes(v, q);
+      }
       // A weight scales every plane of the vertex, and so its share of a merged quadric: the
       // cost rises where detail matters while cost / weight stays a mean squared distance.
       if (!weight_factor_.empty()) q *= weight_factor_[i];
