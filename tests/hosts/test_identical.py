@@ -118,7 +118,7 @@ def main():
                 name = f"{stem}.{op or 'none'}"
                 meshlab_out = ml.path(name + ".meshlab.ply")
                 if op:
-                    code, output, seconds = ml.apply_started(path, meshlab_out, [mt.hedge_filter(ml, op, **params)],
+                    code, output, seconds = ml.apply(path, meshlab_out, [mt.hedge_filter(ml, op, **params)],
                                                              name)
                 else:
                     code, output, seconds = ml.convert(path, meshlab_out)

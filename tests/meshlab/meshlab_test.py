@@ -147,18 +147,27 @@ class MeshLab:
         return env
 
     def run_server(self, arguments, timeout=900):
-        """Runs the runner with `arguments` as they are; returns (exit code, output, seconds)."""
+        """Runs the runner with `arguments` as they are; returns (exit code, output, seconds).
+        meshlabserver is run again (3 runs at most) while it dies before it loads any plugin:
+        once in a few hundred runs on a loaded machine its X connection fails (SIGPIPE, or Qt
+        "could not connect to display" and abort), and the run did not happen."""
         command = [self.server] + arguments
         if self.runner == "hedge-mlx":
             command = [self.server, "--plugins", os.path.dirname(self.args.plugin)] + arguments
-        start = time.monotonic()
-        try:
-            done = subprocess.run(command, env=self.env(), capture_output=True, text=True, errors="replace",
-                                  timeout=timeout, cwd=self.out)
-        except subprocess.TimeoutExpired as e:
-            raise Failure(f"{os.path.basename(self.server)} {' '.join(arguments)} took more than {timeout} s") from e
-        seconds = time.monotonic() - start
-        return done.returncode, done.stdout + done.stderr, seconds
+        for _ in range(3):
+            start = time.monotonic()
+            try:
+                done = subprocess.run(command, env=self.env(), capture_output=True, text=True, errors="replace",
+                                      timeout=timeout, cwd=self.out)
+            except subprocess.TimeoutExpired as e:
+                raise Failure(f"{os.path.basename(self.server)} {' '.join(arguments)} took more than {timeout} s") from e
+            seconds = time.monotonic() - start
+            output = done.stdout + done.stderr
+            if (self.runner != "meshlabserver" or done.returncode in (0, self.filter_failed)
+                    or "Loading Plugins" in output):
+                break
+            print(f"  NOTE  meshlabserver died before starting (exit {done.returncode}); run again")
+        return done.returncode, output, seconds
 
     def arguments(self, mesh_in, mesh_out, script, save_flags=None):
         """The runner's arguments to load mesh_in, run script (None: no filter) and save mesh_out
@@ -192,17 +201,6 @@ class MeshLab:
                                                 timeout)
         with open(os.path.join(self.out, name + ".log"), "w") as f:
             f.write(output)
-        return code, output, seconds
-
-    def apply_started(self, mesh_in, mesh_out, filters, name, **kwargs):
-        """apply(), run again (3 runs at most) while meshlabserver dies before it loads any plugin:
-        once in a few hundred runs on a loaded machine its X connection fails (SIGPIPE, or Qt
-        "could not connect to display" and abort), and the run did not happen."""
-        for _ in range(3):
-            code, output, seconds = self.apply(mesh_in, mesh_out, filters, name, **kwargs)
-            if code in (0, self.filter_failed) or "Loading Plugins" in output or self.runner != "meshlabserver":
-                break
-            print(f"  NOTE  {name}: meshlabserver died before starting (exit {code}); run again")
         return code, output, seconds
 
     def filters(self):

@@ -39,7 +39,7 @@ def main():
             if op is None:
                 code, output, seconds = ml.convert(mesh, out, timeout=TIMEOUT)
             else:
-                code, output, seconds = ml.apply_started(mesh, out, [mt.hedge_filter(ml, op["id"])], name,
+                code, output, seconds = ml.apply(mesh, out, [mt.hedge_filter(ml, op["id"])], name,
                                                          timeout=TIMEOUT)
             return mesh, op, out, code, output, seconds
 

@@ -91,7 +91,7 @@ def main():
             name = f"{case.name}.{op['id']}"
             out = ml.path(name + ".ply")
             try:
-                code, output, seconds = ml.apply_started(path, out, [mt.hedge_filter(ml, op["id"])], name,
+                code, output, seconds = ml.apply(path, out, [mt.hedge_filter(ml, op["id"])], name,
                                                          timeout=TIMEOUT)
             except mt.Failure as e:
                 return case, op, out, None, str(e), TIMEOUT
