@@ -260,16 +260,6 @@ void Mesh::delete_vertex(Vertex v) {
 }
 
 namespace {
-// The live elements, in index order.
-template <class IsDeleted>
-std::vector<Index> live_elements(std::size_t n, IsDeleted is_deleted) {
-  std::vector<Index> live;
-  live.reserve(n);
-  for (std::size_t i = 0; i < n; ++i)
-    if (!is_deleted(static_cast<Index>(i))) live.push_back(static_cast<Index>(i));
-  return live;
-}
-
 // data[i] becomes data[new_to_old[i]], and each element x then f(x), on all threads.
 template <class Array, class F>
 void gather(Array& data, std::span<const Index> new_to_old, F f) {
@@ -279,15 +269,6 @@ void gather(Array& data, std::span<const Index> new_to_old, F f) {
   });
   data.swap(out);
 }
-
-// The live vertices, edges and faces of m, each in index order.
-struct LiveElements {
-  std::vector<Index> vertices, edges, faces;
-  explicit LiveElements(const Mesh& m)
-      : vertices(live_elements(m.vertices_size(), [&](Index i) { return m.is_deleted(Vertex(i)); })),
-        edges(live_elements(m.edges_size(), [&](Index i) { return m.is_deleted(Edge(i)); })),
-        faces(live_elements(m.faces_size(), [&](Index i) { return m.is_deleted(Face(i)); })) {}
-};
 
 // maps: old -> new for every old element, invalid for those not kept.
 void fill_maps(GarbageMaps& maps, std::span<const Index> vkeep, std::span<const Index> ekeep,
@@ -309,49 +290,89 @@ struct ThroughMaps {
   Index face(Index i) const { return maps.faces[i]; }
 };
 
-// Old -> new index of a live element when the live elements keep their order: the number
-// of live elements before it, from a count per 64 deletion marks and the marks themselves
-// (bytes of 0 or 1, summed eight at a time).
-class LiveRank {
+// Bits set in a word, without the popcnt instruction the baseline x86-64 target lacks.
+inline unsigned count_bits(std::uint64_t x) {
+  x -= (x >> 1) & 0x5555555555555555ull;
+  x = (x & 0x3333333333333333ull) + ((x >> 2) & 0x3333333333333333ull);
+  x = (x + (x >> 4)) & 0x0f0f0f0f0f0f0f0full;
+  return unsigned((x * 0x0101010101010101ull) >> 56);
+}
+
+// The live elements of one kind as a bit per element (set: live), 64 to a word, with the
+// number of live elements before each word: an element's new index when the live elements
+// keep their order is that count plus the live bits below it in its word.
+class LiveSet {
  public:
-  static constexpr std::size_t kBlock = 64;
-  explicit LiveRank(const std::vector<std::uint8_t>& deleted) : deleted_(deleted) {
-    if (deleted.empty()) return;
-    before_.resize(deleted.size() / kBlock + 1);
+  // deleted: the deletion marks (bytes of 0 or 1), or empty when nothing of this kind was
+  // deleted; n: how many elements there are.
+  LiveSet(const std::vector<std::uint8_t>& deleted, std::size_t n) : n_(n) {
+    const std::size_t words = (n + 63) / 64;
+    words_.resize(words);
+    parallel_for(
+        words, 0,
+        [&](std::size_t begin, std::size_t end) {
+          for (std::size_t w = begin; w < end; ++w) words_[w] = live_bits(deleted, w);
+        },
+        4096);
+    before_.resize(words + 1);
     Index live = 0;
-    for (std::size_t b = 0; b < before_.size(); ++b) {
-      before_[b] = live;
-      const std::size_t begin = b * kBlock, end = std::min(begin + kBlock, deleted.size());
-      live += Index(end - begin) - deleted_between(begin, end);
+    for (std::size_t w = 0; w < words; ++w) {
+      before_[w] = live;
+      live += count_bits(words_[w]);
     }
+    before_[words] = live;
   }
-  Index operator()(Index old) const {
-    if (deleted_.empty()) return old;  // nothing of this kind was deleted
-    const std::size_t begin = old / kBlock * kBlock;
-    return before_[old / kBlock] + Index(old - begin) - deleted_between(begin, old);
+
+  std::size_t size() const { return before_.back(); }
+  Index rank(Index old) const {
+    const std::uint64_t below = (std::uint64_t(1) << (old & 63)) - 1;
+    return before_[old >> 6] + count_bits(words_[old >> 6] & below);
+  }
+  // The live elements in index order.
+  std::vector<Index> elements() const {
+    std::vector<Index> out(size());
+    parallel_for(
+        words_.size(), 0,
+        [&](std::size_t begin, std::size_t end) {
+          for (std::size_t w = begin; w < end; ++w) {
+            Index* at = out.data() + before_[w];
+            for (std::uint64_t bits = words_[w]; bits; bits &= bits - 1)
+              *at++ = Index(w * 64 + unsigned(__builtin_ctzll(bits)));
+          }
+        },
+        4096);
+    return out;
   }
 
  private:
-  Index deleted_between(std::size_t begin, std::size_t end) const {
-    Index count = 0;
+  // Word w's live bits: eight deletion bytes at a time gathered into eight bits by one
+  // multiplication (each byte's low bit lands in the top byte at its own place), inverted.
+  std::uint64_t live_bits(const std::vector<std::uint8_t>& deleted, std::size_t w) const {
+    const std::size_t begin = w * 64, end = std::min(begin + 64, n_);
+    const std::uint64_t all = end - begin == 64 ? ~std::uint64_t(0) : (std::uint64_t(1) << (end - begin)) - 1;
+    if (deleted.empty()) return all;
+    std::uint64_t dead = 0;
     std::size_t i = begin;
     for (; i + 8 <= end; i += 8) {
-      std::uint64_t word;
-      std::memcpy(&word, deleted_.data() + i, sizeof word);
-      count += Index((word * 0x0101010101010101ull) >> 56);
+      std::uint64_t bytes;
+      std::memcpy(&bytes, deleted.data() + i, sizeof bytes);
+      dead |= ((bytes * 0x0102040810204080ull) >> 56) << (i - begin);
     }
-    for (; i < end; ++i) count += deleted_[i];
-    return count;
+    for (; i < end; ++i) dead |= std::uint64_t(deleted[i]) << (i - begin);
+    return ~dead & all;
   }
-  const std::vector<std::uint8_t>& deleted_;
+
+  std::size_t n_;
+  std::vector<std::uint64_t> words_;
   std::vector<Index> before_;
 };
 
-struct ByRank {
-  LiveRank vertices, edges, faces;
-  Index vertex(Index i) const { return vertices(i); }
-  Index edge(Index i) const { return edges(i); }
-  Index face(Index i) const { return faces(i); }
+// The live vertices, edges and faces; old -> new by rank.
+struct LiveSets {
+  LiveSet vertices, edges, faces;
+  Index vertex(Index i) const { return vertices.rank(i); }
+  Index edge(Index i) const { return edges.rank(i); }
+  Index face(Index i) const { return faces.rank(i); }
 };
 }  // namespace
 
@@ -367,17 +388,29 @@ GarbageMaps Mesh::garbage_collect() {
     identity(maps.faces, faces_size());
     return maps;
   }
-  const LiveElements live(*this);
-  fill_maps(maps, live.vertices, live.edges, live.faces, vertices_size(), edges_size(), faces_size());
-  renumber(live.vertices, live.edges, live.faces, ThroughMaps{maps});
+  const LiveSets live{LiveSet(vdeleted_, vertices_size()), LiveSet(edeleted_, edges_size()),
+                      LiveSet(fdeleted_, faces_size())};
+  // Old -> new for every old element, invalid for the deleted.
+  auto old_to_new = [](std::vector<Index>& map, const LiveSet& set, const std::vector<std::uint8_t>& deleted,
+                       std::size_t n) {
+    map.resize(n);
+    parallel_for(n, 0, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i)
+        map[i] = !deleted.empty() && deleted[i] ? kInvalidIndex : set.rank(Index(i));
+    });
+  };
+  old_to_new(maps.vertices, live.vertices, vdeleted_, vertices_size());
+  old_to_new(maps.edges, live.edges, edeleted_, edges_size());
+  old_to_new(maps.faces, live.faces, fdeleted_, faces_size());
+  renumber(live.vertices.elements(), live.edges.elements(), live.faces.elements(), live);
   return maps;
 }
 
 void Mesh::compact() {
   if (!has_garbage()) return;
-  const LiveElements live(*this);
-  renumber(live.vertices, live.edges, live.faces,
-           ByRank{LiveRank(vdeleted_), LiveRank(edeleted_), LiveRank(fdeleted_)});
+  const LiveSets live{LiveSet(vdeleted_, vertices_size()), LiveSet(edeleted_, edges_size()),
+                      LiveSet(fdeleted_, faces_size())};
+  renumber(live.vertices.elements(), live.edges.elements(), live.faces.elements(), live);
 }
 
 GarbageMaps Mesh::reorder(std::span<const Index> vertex_order, std::span<const Index> edge_order,
@@ -412,12 +445,13 @@ GarbageMaps Mesh::reorder(std::span<const Index> vertex_order, std::span<const I
 template <class Renumbered>
 void Mesh::renumber(std::span<const Index> vkeep, std::span<const Index> ekeep, std::span<const Index> fkeep,
                     const Renumbered& renumbered) {
-  std::vector<Index> hkeep;
-  hkeep.reserve(2 * ekeep.size());
-  for (Index e : ekeep) {
-    hkeep.push_back(2 * e);
-    hkeep.push_back(2 * e + 1);
-  }
+  std::vector<Index> hkeep(2 * ekeep.size());
+  parallel_for(ekeep.size(), 0, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      hkeep[2 * i] = 2 * ekeep[i];
+      hkeep[2 * i + 1] = 2 * ekeep[i] + 1;
+    }
+  });
 
   // Live elements refer only to live elements.
   auto map_h = [&](Halfedge h) {
