@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <mutex>
 #include <vector>
 
 #include "parallel.h"
@@ -71,14 +72,26 @@ std::vector<Index> order_by_bucket(std::size_t n, std::size_t live, std::size_t 
 
 std::uint32_t morton_cell(const Vec3f& p, double offset, int bits) { return cell_code(p, offset, bits); }
 
-Frame normalized_frame(const Mesh& m) {
-  constexpr double inf = std::numeric_limits<double>::infinity();
-  Vec3d lo{{inf, inf, inf}}, hi{{-inf, -inf, -inf}};
-  for (Vertex v : m.vertices()) {
-    const Vec3d p = to_double(m.position(v));
-    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
-  }
-  Frame frame{(lo + hi) * 0.5, distance(lo, hi)};
+Frame normalized_frame(const Mesh& m, unsigned threads) {
+  // The box in floats, each thread over a range of vertices, then joined: min and max are
+  // exact, so the box is the same whatever the split (zeros made +0, the one difference).
+  constexpr float inf = std::numeric_limits<float>::infinity();
+  Vec3f lo{{inf, inf, inf}}, hi{{-inf, -inf, -inf}};
+  std::mutex joining;
+  parallel_for(m.vertices_size(), threads, [&](std::size_t begin, std::size_t end) {
+    Vec3f part_lo{{inf, inf, inf}}, part_hi{{-inf, -inf, -inf}};
+    for (std::size_t i = begin; i < end; ++i) {
+      const Vertex v(static_cast<Index>(i));
+      if (m.is_deleted(v)) continue;
+      const Vec3f& p = m.position(v);
+      for (int k = 0; k < 3; ++k) part_lo[k] = std::min(part_lo[k], p[k]), part_hi[k] = std::max(part_hi[k], p[k]);
+    }
+    const std::lock_guard lock(joining);
+    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], part_lo[k]), hi[k] = std::max(hi[k], part_hi[k]);
+  });
+  for (int k = 0; k < 3; ++k) lo[k] += 0.0f, hi[k] += 0.0f;
+  const Vec3d lo_d = to_double(lo), hi_d = to_double(hi);
+  Frame frame{(lo_d + hi_d) * 0.5, distance(lo_d, hi_d)};
   if (!(frame.scale > 0) || !std::isfinite(frame.scale)) frame.scale = 1;
   return frame;
 }
@@ -86,7 +99,7 @@ Frame normalized_frame(const Mesh& m) {
 GarbageMaps sort_spatially(Mesh& m, unsigned threads) {
   // 1. The live vertices along the Morton order of their cells (10 bits per axis) in the
   // normalized frame; the codes on all threads.
-  const Frame frame = normalized_frame(m);
+  const Frame frame = normalized_frame(m, threads);
   constexpr int kBits = 10;
   std::vector<std::uint64_t> coded(m.vertices_size());
   parallel_for(m.vertices_size(), threads, [&](std::size_t begin, std::size_t end) {

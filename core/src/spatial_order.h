@@ -15,12 +15,12 @@ namespace hedge::detail {
 
 //! A mesh's normalized frame: the centre of its vertices' bounding box and the box's
 //! diagonal (1 when that is zero or not finite). (p - center) / scale lies in the box
-//! centred on the origin whose diagonal is 1.
+//! centred on the origin whose diagonal is 1. On up to `threads` threads (0: all).
 struct Frame {
   Vec3d center;
   double scale = 1;
 };
-Frame normalized_frame(const Mesh& m);
+Frame normalized_frame(const Mesh& m, unsigned threads = 0);
 
 //! The Morton code of a point of a normalized frame (the bounding box centred on the
 //! origin, its diagonal 1): `bits` per axis (at most 10), interleaved, of the grid moved by
