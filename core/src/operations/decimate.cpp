@@ -614,14 +614,27 @@ class Decimator {
 };
 
 void Decimator::triangulate_polygons() {
-  std::vector<Face> polygons;
   // With selection_only, polygons outside the selection stay: their vertices are all locked,
   // so no collapse reaches them.
   const std::vector<std::uint8_t> selected =
       opt_.selection_only ? detail::selected_faces(m_) : std::vector<std::uint8_t>();
-  for (Face f : m_.faces())
-    if (m_.next(m_.next(m_.next(m_.halfedge(f)))) != m_.halfedge(f) && (selected.empty() || selected[f.idx()]))
-      polygons.push_back(f);
+  auto is_polygon = [&](Face f) {
+    return !m_.is_deleted(f) && m_.next(m_.next(m_.next(m_.halfedge(f)))) != m_.halfedge(f) &&
+           (selected.empty() || selected[f.idx()]);
+  };
+  // Meshes are mostly triangles already: the scan that finds none runs on all threads, and
+  // only a mesh with polygons lists them (in order) and splits them.
+  std::atomic<std::size_t> found{0};
+  parallel_for(m_.faces_size(), opt_.threads, [&](std::size_t begin, std::size_t end) {
+    std::size_t count = 0;
+    for (std::size_t i = begin; i < end; ++i) count += is_polygon(Face(Index(i)));
+    found += count;
+  });
+  if (found == 0) return;
+  std::vector<Face> polygons;
+  polygons.reserve(found);
+  for (std::size_t i = 0, n = m_.faces_size(); i < n; ++i)
+    if (is_polygon(Face(Index(i)))) polygons.push_back(Face(Index(i)));
   for (Face f : polygons) m_.triangulate(f);
   report_.triangulated_faces = polygons.size();
 }
@@ -629,7 +642,7 @@ void Decimator::triangulate_polygons() {
 // Quadrics are built in coordinates centred on the bounding box and scaled by its diagonal:
 // errors come out as fractions of the diagonal and keep their precision far from the origin.
 void Decimator::compute_frame() {
-  const detail::Frame frame = detail::normalized_frame(m_);
+  const detail::Frame frame = detail::normalized_frame(m_, opt_.threads);
   center_ = frame.center;
   scale_ = frame.scale;
   inv_scale_ = 1 / scale_;
