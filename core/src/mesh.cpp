@@ -324,6 +324,7 @@ class LiveSet {
   }
 
   std::size_t size() const { return before_.back(); }
+  bool contains(Index i) const { return (words_[i >> 6] >> (i & 63)) & 1; }
   Index rank(Index old) const {
     const std::uint64_t below = (std::uint64_t(1) << (old & 63)) - 1;
     return before_[old >> 6] + count_bits(words_[old >> 6] & below);
@@ -391,17 +392,15 @@ GarbageMaps Mesh::garbage_collect() {
   const LiveSets live{LiveSet(vdeleted_, vertices_size()), LiveSet(edeleted_, edges_size()),
                       LiveSet(fdeleted_, faces_size())};
   // Old -> new for every old element, invalid for the deleted.
-  auto old_to_new = [](std::vector<Index>& map, const LiveSet& set, const std::vector<std::uint8_t>& deleted,
-                       std::size_t n) {
+  auto old_to_new = [](std::vector<Index>& map, const LiveSet& set, std::size_t n) {
     map.resize(n);
     parallel_for(n, 0, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t i = begin; i < end; ++i)
-        map[i] = !deleted.empty() && deleted[i] ? kInvalidIndex : set.rank(Index(i));
+      for (std::size_t i = begin; i < end; ++i) map[i] = set.contains(Index(i)) ? set.rank(Index(i)) : kInvalidIndex;
     });
   };
-  old_to_new(maps.vertices, live.vertices, vdeleted_, vertices_size());
-  old_to_new(maps.edges, live.edges, edeleted_, edges_size());
-  old_to_new(maps.faces, live.faces, fdeleted_, faces_size());
+  old_to_new(maps.vertices, live.vertices, vertices_size());
+  old_to_new(maps.edges, live.edges, edges_size());
+  old_to_new(maps.faces, live.faces, faces_size());
   renumber(live.vertices.elements(), live.edges.elements(), live.faces.elements(), live);
   return maps;
 }

@@ -118,8 +118,7 @@ def main():
                 name = f"{stem}.{op or 'none'}"
                 meshlab_out = ml.path(name + ".meshlab.ply")
                 if op:
-                    code, output, seconds = ml.apply(path, meshlab_out, [mt.hedge_filter(ml, op, **params)],
-                                                             name)
+                    code, output, seconds = ml.apply(path, meshlab_out, [mt.hedge_filter(ml, op, **params)], name)
                 else:
                     code, output, seconds = ml.convert(path, meshlab_out)
                 if checks.check(code == 0 and os.path.exists(meshlab_out),
