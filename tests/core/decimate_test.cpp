@@ -523,6 +523,31 @@ TEST(Decimate, VertexAttributesAreInterpolated) {
   EXPECT_LT(worst, 0.05);  // of a range of 3
 }
 
+TEST(Decimate, IdsNameOneOfTheMergedVertices) {
+  // An integer vertex channel does not blend: each collapse keeps one of its two ends' values,
+  // so on a manifold mesh (no copies of split vertices sharing an id) the ids stay distinct; a
+  // neighbour's id would name a vertex twice.
+  const std::string path = std::string(HEDGE_MESH_DIR) + "/bunny.off";
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "bunny.off not present";
+  Soup s = read_mesh(path);
+  auto* id = s.add_channel("id", Domain::vertex, ScalarType::i32, 1).as<std::int32_t>();
+  for (std::size_t i = 0; i < s.n_vertices(); ++i) id[i] = static_cast<std::int32_t>(i);
+  Mesh mesh = build(s).mesh;
+  DecimateOptions o;
+  o.target_ratio = 0.1;
+  decimate(mesh, o);
+  const ChannelArray& ids = *mesh.vertex_properties().get_channel("id");
+  std::set<std::int32_t> seen;
+  for (Vertex v : mesh.vertices()) {
+    std::int32_t value;
+    std::memcpy(&value, ids.element(v.idx()), sizeof value);
+    ASSERT_GE(value, 0);
+    ASSERT_LT(std::size_t(value), s.n_vertices());
+    EXPECT_TRUE(seen.insert(value).second) << "id " << value << " names two vertices";
+  }
+  EXPECT_EQ(seen.size(), mesh.n_vertices());
+}
+
 // ---- weights and locks ------------------------------------------------------------------------
 
 // An icosphere with a vertex channel: `value(position)` at each vertex.

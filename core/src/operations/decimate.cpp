@@ -480,7 +480,7 @@ class Decimator {
     float weight[3] = {0, 0, 0};  // non-negative, normalized in blend_element
   };
   Blend locate(const Vec3d& p, std::span<const Face> faces) const;
-  void locate_vertex(const Candidate& c, Scratch& s) const;
+  void locate_vertex(Vertex v0, Vertex v1, const Candidate& c, Scratch& s) const;
   void gather_wedges(Halfedge h, const Point& target, Scratch& s) const;
   void blend_wedges(Vertex kept, const Scratch& s);
   void interpolate_vertex(Vertex removed, Vertex kept, const Candidate& c, Scratch& s);
@@ -524,21 +524,22 @@ class Decimator {
   };
 
   std::vector<ChannelArray*> corner_channels_;  // host per-corner channels (seams are judged on these)
-  // Vertex properties; host channels (not build()'s internal arrays) are interpolated in
-  // the triangle holding the new vertex.
+  // Vertex properties. Real-valued host channels blend in the old triangle holding the new
+  // vertex, which takes a search of the faces around the collapse; the rest (build()'s
+  // internal arrays, and host ids, flags and 8-bit colours, which do not blend) take the
+  // nearer end's value, so an id always names one of the two vertices merged.
   struct VertexArray {
     PropertyArray* array;
-    ChannelArray* channel;  // when it is a host channel
+    ChannelArray* located;  // a real-valued host channel, blended where the vertex lands
   };
   std::vector<VertexArray> vertex_arrays_;
-  bool vertex_channels_ = false;
+  bool locate_vertices_ = false;  // some vertex channel is located
 
   // What testing and making one collapse needs besides the mesh, reused from one collapse to
   // the next (no allocation per collapse), and the fetching ahead of the next one.
   struct Scratch {
     std::vector<RingEntry> ring0, ring1;  // check(): both ends' rings
     double worst_new = 1, worst_old = 1;  // triangle quality around the collapse being tested
-    std::vector<Face> faces;
     Index vertex_blend_index[3];
     float vertex_blend_weight[3];
     int vertex_blend_size = 0;
@@ -827,10 +828,13 @@ void Decimator::find_corner_channels() {
   PropertyContainer& vp = m_.vertex_properties();
   for (std::size_t i = 0; i < vp.count(); ++i) {
     PropertyArray& a = vp.at(i);
-    ChannelArray* channel = nullptr;
-    if (a.type() == typeid(ChannelArray) && !a.is_internal()) channel = static_cast<ChannelArray*>(&a);
-    vertex_arrays_.push_back({&a, channel});
-    vertex_channels_ = vertex_channels_ || channel;
+    ChannelArray* located = nullptr;
+    if (a.type() == typeid(ChannelArray) && !a.is_internal()) {
+      auto* channel = static_cast<ChannelArray*>(&a);
+      if (channel->scalar() == ScalarType::f32 || channel->scalar() == ScalarType::f64) located = channel;
+    }
+    vertex_arrays_.push_back({&a, located});
+    locate_vertices_ = locate_vertices_ || located;
   }
 }
 
@@ -1468,7 +1472,7 @@ Decimator::Refusal Decimator::check(Halfedge h, const Point& target, Scratch& s,
     if (vr.is_valid()) s.worst_old = std::min(s.worst_old, triangle_quality(p1, p0, at(vr)));
   }
   auto faces_ok = [&](Vertex v, std::vector<RingEntry>& ring) {
-    for (RingEntry& r : ring) r.position = at(r.vertex);
+    for (RingEntry& r : ring) r.position = at(r.vertex);  // locate_vertex() reads them too
     const Vec3d apex = at(v);
     const std::size_t n = ring.size();
     for (std::size_t i = 0; i < n; ++i) {
@@ -1632,20 +1636,39 @@ void Decimator::blend_wedges(Vertex kept, const Scratch& s) {
   }
 }
 
-// Vertex attributes at the new vertex: host channels by barycentric interpolation in the old
-// triangle holding it (among the faces around both ends, gathered by check()), located
-// before the collapse while those triangles exist; internal arrays (build()'s provenance)
-// by the generic interpolation along the edge.
-void Decimator::locate_vertex(const Candidate& c, Scratch& s) const {
-  s.faces.clear();
-  for (const RingEntry& r : s.ring0) s.faces.push_back(r.face);
-  for (const RingEntry& r : s.ring1) s.faces.push_back(r.face);
-  const Blend b = locate(to_double(c.position), s.faces);
+// Vertex attributes at the new vertex: real-valued host channels by barycentric interpolation
+// in the old triangle holding it, located before the collapse while those triangles exist;
+// everything else by the generic interpolation along the edge (the nearer end's value).
+// The triangles are those around both ends, from the rings check() has just walked and
+// placed (RingEntry::position, in the normalized frame): each face around an end is that end
+// and two neighbours in turn, so no face is walked again.
+void Decimator::locate_vertex(Vertex v0, Vertex v1, const Candidate& c, Scratch& s) const {
+  const Vec3d p = local(c.position);
+  double best_distance = std::numeric_limits<double>::infinity();
+  Vertex best[3];
+  Vec3d best_weights{};
+  auto search = [&](Vertex apex, const std::vector<RingEntry>& ring) {
+    const Vec3d at_apex = at(apex);
+    for (std::size_t i = 0, n = ring.size(); i < n; ++i) {
+      if (!ring[i].face.is_valid()) continue;
+      const RingEntry& next = ring[i + 1 == n ? 0 : i + 1];
+      const ClosestPoint cp = closest_point_on_triangle(p, at_apex, ring[i].position, next.position);
+      if (cp.distance < best_distance) {
+        best_distance = cp.distance;
+        best[0] = apex, best[1] = ring[i].vertex, best[2] = next.vertex;
+        best_weights = cp.barycentric;
+      }
+    }
+  };
+  search(v0, s.ring0);
+  search(v1, s.ring1);
   s.vertex_blend_size = 0;
-  if (!b.corner[0].is_valid()) return;
+  float weight[3];
+  for (int i = 0; i < 3; ++i) weight[i] = float(std::clamp(best_weights[i], 0.0, 1.0));
+  if (!(weight[0] + weight[1] + weight[2] > 0)) return;
   for (int i = 0; i < 3; ++i) {
-    s.vertex_blend_index[i] = m_.to_vertex(b.corner[i]).idx();
-    s.vertex_blend_weight[i] = b.weight[i];
+    s.vertex_blend_index[i] = best[i].idx();
+    s.vertex_blend_weight[i] = weight[i];
   }
   s.vertex_blend_size = 3;
 }
@@ -1660,15 +1683,15 @@ void Decimator::interpolate_vertex(Vertex removed, Vertex kept, const Candidate&
   for (const VertexArray& a : vertex_arrays_) {
     // Where a copy goes, the kept vertex keeps its own source: taking the copy's would weld
     // it to the copy's other copies.
-    if (copies && !a.channel && a.array->is_internal()) continue;
-    if (a.channel && s.vertex_blend_size == 3 && a.channel->stride() <= 256) {
+    if (copies && a.array->is_internal()) continue;
+    if (a.located && s.vertex_blend_size == 3 && a.located->stride() <= 256) {
       // Deleted vertices keep their rows until garbage collection: the removed end's too.
       std::byte out[256];
-      const std::byte* src[3] = {a.channel->element(s.vertex_blend_index[0]),
-                                 a.channel->element(s.vertex_blend_index[1]),
-                                 a.channel->element(s.vertex_blend_index[2])};
-      blend_element(*a.channel, out, src, s.vertex_blend_weight);
-      std::memcpy(a.channel->element(kept.idx()), out, a.channel->stride());
+      const std::byte* src[3] = {a.located->element(s.vertex_blend_index[0]),
+                                 a.located->element(s.vertex_blend_index[1]),
+                                 a.located->element(s.vertex_blend_index[2])};
+      blend_element(*a.located, out, src, s.vertex_blend_weight);
+      std::memcpy(a.located->element(kept.idx()), out, a.located->stride());
     } else {
       a.array->interpolate(kept.idx(), std::span<const Index>(s.interp_index, 2),
                            std::span<const float>(s.interp_weight, 2));
@@ -1690,7 +1713,7 @@ Decimator::Collapsed Decimator::apply_collapse(Halfedge h, const Candidate& c, S
 
   if (!corner_channels_.empty()) gather_wedges(h, c.position, s);
   // Located before the collapse, while the old triangles exist; written after it.
-  if (vertex_channels_) locate_vertex(c, s);
+  if (locate_vertices_) locate_vertex(v0, v1, c, s);
   // check() has just passed: it implies Mesh::is_collapse_ok() on a triangle mesh (its link
   // test, ears, pinches and 3-edge holes are the same; a tetrahedron's apex has valence 3,
   // which kValenceLeft/Right refuse), so the mesh's own test, which costs as much as the
