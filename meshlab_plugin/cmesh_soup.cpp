@@ -277,19 +277,21 @@ Soup soup_from_mesh(const MeshModel& model) {
   }
   // Soup faces: the triangles, or for a polygonal mesh the polygons their faux edges make.
   // live_faces[f] is the MeshLab face soup face f takes its attributes from (a polygon's first
-  // triangle); corner_wedges[c] the face and wedge soup corner c takes its own from.
+  // triangle); wedge_of(c) the face and wedge soup corner c takes its own from, listed only
+  // for polygons (a triangle's corners are its wedges in order).
   std::vector<std::size_t> live_faces;
   std::vector<CornerWedge> corner_wedges;
-  if (model.hasDataMask(MeshModel::MM_POLYGONAL)) {
+  const bool polygonal = model.hasDataMask(MeshModel::MM_POLYGONAL);
+  if (polygonal) {
     gather_polygons(m, triangles, triangle_vertices, soup, live_faces, corner_wedges);
   } else {
-    live_faces = triangles;
-    soup.corners = triangle_vertices;
-    soup.face_sizes.assign(triangles.size(), 3);
-    corner_wedges.resize(soup.corners.size());
-    for (std::size_t t = 0; t < triangles.size(); ++t)
-      for (std::uint8_t j = 0; j < 3; ++j) corner_wedges[3 * t + j] = {triangles[t], j};
+    live_faces = std::move(triangles);
+    soup.corners = std::move(triangle_vertices);
+    soup.face_sizes.assign(live_faces.size(), 3);
   }
+  auto wedge_of = [&](std::size_t c) -> CornerWedge {
+    return polygonal ? corner_wedges[c] : CornerWedge{live_faces[c / 3], static_cast<std::uint8_t>(c % 3)};
+  };
 
   const std::size_t nv = live_vertices.size(), nf = live_faces.size();
   if (model.hasDataMask(MeshModel::MM_VERTNORMAL)) {
@@ -333,8 +335,9 @@ Soup soup_from_mesh(const MeshModel& model) {
   }
   if (model.hasDataMask(MeshModel::MM_WEDGTEXCOORD) && m.face.IsWedgeTexCoordEnabled()) {
     auto* uv = soup.add_channel("uv", Domain::corner, ScalarType::f32, 2).as<float>();
-    for (std::size_t c = 0; c < corner_wedges.size(); ++c) {
-      const auto& wedge = m.face[corner_wedges[c].face].cWT(corner_wedges[c].wedge);
+    for (std::size_t c = 0; c < soup.corners.size(); ++c) {
+      const CornerWedge at = wedge_of(c);
+      const auto& wedge = m.face[at.face].cWT(at.wedge);
       uv[2 * c] = wedge.U();
       uv[2 * c + 1] = wedge.V();
     }
