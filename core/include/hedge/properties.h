@@ -177,6 +177,33 @@ class ChannelArray final : public PropertyArray {
   const std::vector<std::byte>& bytes() const { return data_; }
   std::byte* element(std::size_t i) { return data_.data() + i * stride_; }
   const std::byte* element(std::size_t i) const { return data_.data() + i * stride_; }
+  //! Whether elements a and b hold the same bytes. The common sizes compare as words: a call
+  //! to memcmp for each corner compared was a sixth of decimating a mesh with a UV map.
+  bool same(std::size_t a, std::size_t b) const {
+    const std::byte *x = element(a), *y = element(b);
+    auto word = [](const std::byte* p, std::size_t at) {
+      std::uint64_t w;
+      std::memcpy(&w, p + at, sizeof w);
+      return w;
+    };
+    auto half = [](const std::byte* p, std::size_t at) {
+      std::uint32_t w;
+      std::memcpy(&w, p + at, sizeof w);
+      return w;
+    };
+    switch (stride_) {
+      case 4:
+        return half(x, 0) == half(y, 0);
+      case 8:
+        return word(x, 0) == word(y, 0);
+      case 12:
+        return word(x, 0) == word(y, 0) && half(x, 8) == half(y, 8);
+      case 16:
+        return word(x, 0) == word(y, 0) && word(x, 8) == word(y, 8);
+      default:
+        return std::memcmp(x, y, stride_) == 0;
+    }
+  }
 
   std::size_t size() const override { return stride_ ? data_.size() / stride_ : 0; }
   void resize(std::size_t n) override { data_.resize(n * stride_); }

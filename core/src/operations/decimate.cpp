@@ -396,7 +396,7 @@ class Decimator {
   double shapes_weight(Vertex a, Vertex b) const;
   bool corners_equal(Halfedge a, Halfedge b) const {
     for (const ChannelArray* c : corner_channels_)
-      if (std::memcmp(c->element(a.idx()), c->element(b.idx()), c->stride()) != 0) return false;
+      if (!c->same(a.idx(), b.idx())) return false;
     return true;
   }
   // kPlace: also where the new vertex goes and how its attributes blend (c.position,
@@ -475,11 +475,17 @@ class Decimator {
   // apply_collapse() and what follows in w's queue; returns the number of faces removed.
   int collapse(Halfedge h, const Candidate& c, Worker& w);
   // Barycentric coordinates of a point in a triangle, by its corner half-edges.
-  struct Blend {
-    Halfedge corner[3];
+  struct RingEntry;
+  // A face around one end of the collapse, as check() walked it: the end (apex) and entries i
+  // and i + 1 of its ring, with barycentric weights in that order.
+  struct RingHit {
+    const std::vector<RingEntry>* ring = nullptr;  // null: nothing found
+    Vertex apex;
+    std::size_t i = 0;
     float weight[3] = {0, 0, 0};  // non-negative, normalized in blend_element
   };
-  Blend locate(const Vec3d& p, std::span<const Face> faces) const;
+  template <class Take>
+  RingHit nearest_in_rings(const Vec3d& p, Vertex v0, Vertex v1, const Scratch& s, Take take) const;
   void locate_vertex(Vertex v0, Vertex v1, const Candidate& c, Scratch& s) const;
   void gather_wedges(Halfedge h, const Point& target, Scratch& s) const;
   void blend_wedges(Vertex kept, const Scratch& s);
@@ -520,6 +526,7 @@ class Decimator {
   struct RingEntry {
     Vertex vertex;  // a neighbour, in counter-clockwise order
     Face face;      // the face between it and the next neighbour (invalid: a hole)
+    Halfedge out;   // to the neighbour from the ring's end: the face's corner at the neighbour
     Vec3d position;
   };
 
@@ -1413,7 +1420,7 @@ Decimator::Refusal Decimator::check(Halfedge h, const Point& target, Scratch& s,
     // the kept vertex's edges reads next, so the mesh's positions stay out of the loop):
     // start those cache misses now, so they overlap the link test instead of following it.
     detail::prefetch(&vd_[w.idx()]);
-    ring.push_back({w, m_.face(x), Vec3d{}});
+    ring.push_back({w, m_.face(x), x, Vec3d{}});
     x = m_.ccw_rotated(x);
     more = x != start;
   };
@@ -1488,27 +1495,36 @@ Decimator::Refusal Decimator::check(Halfedge h, const Point& target, Scratch& s,
   return kLegal;
 }
 
-// Where the new vertex lies in the old surface: the nearest point of the triangles among
-// `faces`, as a triangle and barycentric coordinates. Interpolating there is exact for
-// attributes linear over the triangle (UV charts, ramps), unlike a blend along the edge
-// when the quadric's optimum leaves it; off the surface, the attributes are those of the
-// surface point the vertex stands for.
-Decimator::Blend Decimator::locate(const Vec3d& p, std::span<const Face> faces) const {
-  Blend best;
+// Where the new vertex lies in the old surface: the nearest point of the faces around both
+// ends that `take(face)` accepts, as a face and barycentric coordinates. Interpolating there is
+// exact for attributes linear over the triangle (UV charts, ramps), unlike a blend along the
+// edge when the quadric's optimum leaves it; off the surface, the attributes are those of the
+// surface point the vertex stands for. The faces are those check() has just walked and placed
+// (RingEntry::position, in the normalized frame): each is an end and two neighbours in turn, so
+// no face is walked again.
+template <class Take>
+Decimator::RingHit Decimator::nearest_in_rings(const Vec3d& p, Vertex v0, Vertex v1, const Scratch& s,
+                                               Take take) const {
+  RingHit best;
   double best_distance = std::numeric_limits<double>::infinity();
-  for (Face f : faces) {
-    if (!f.is_valid()) continue;
-    const Halfedge h0 = m_.halfedge(f), h1 = m_.next(h0), h2 = m_.next(h1);
-    const ClosestPoint cp =
-        closest_point_on_triangle(p, to_double(m_.position(m_.to_vertex(h0))), to_double(m_.position(m_.to_vertex(h1))),
-                                  to_double(m_.position(m_.to_vertex(h2))));
-    if (cp.distance < best_distance) {
-      best_distance = cp.distance;
-      best.corner[0] = h0, best.corner[1] = h1, best.corner[2] = h2;
-      for (int i = 0; i < 3; ++i) best.weight[i] = float(std::clamp(cp.barycentric[i], 0.0, 1.0));
+  Vec3d weights{};
+  auto search = [&](Vertex apex, const std::vector<RingEntry>& ring) {
+    const Vec3d at_apex = at(apex);
+    for (std::size_t i = 0, n = ring.size(); i < n; ++i) {
+      if (!ring[i].face.is_valid() || !take(ring[i].face)) continue;
+      const ClosestPoint cp =
+          closest_point_on_triangle(p, at_apex, ring[i].position, ring[i + 1 == n ? 0 : i + 1].position);
+      if (cp.distance < best_distance) {
+        best_distance = cp.distance;
+        best.ring = &ring, best.apex = apex, best.i = i;
+        weights = cp.barycentric;
+      }
     }
-  }
-  if (!(best.weight[0] + best.weight[1] + best.weight[2] > 0)) return Blend{};
+  };
+  search(v0, s.ring0);
+  search(v1, s.ring1);
+  for (int k = 0; k < 3; ++k) best.weight[k] = float(std::clamp(weights[k], 0.0, 1.0));
+  if (!(best.weight[0] + best.weight[1] + best.weight[2] > 0)) best.ring = nullptr;
   return best;
 }
 
@@ -1586,7 +1602,8 @@ void Decimator::gather_wedges(Halfedge h, const Point& target, Scratch& s) const
   std::size_t bytes = 0;
   for (const ChannelArray* c : corner_channels_) bytes += 2 * c->stride();
   s.wedge_values.resize(bytes);
-  const Vec3d p = to_double(target);
+  const Vec3d p = local(target);
+  const Vertex v0 = m_.to_vertex(o), v1 = m_.to_vertex(h);
   // Across a non-seam edge both sides are one wedge: one value, bit for bit, or the two
   // sides would drift apart by rounding and read as a new seam.
   const bool one_wedge = fl.is_valid() && fr.is_valid() && corners_equal(m_.prev(h), o) && corners_equal(h, m_.prev(o));
@@ -1600,20 +1617,27 @@ void Decimator::gather_wedges(Halfedge h, const Point& target, Scratch& s) const
       }
       continue;
     }
-    std::vector<Face>& faces = s.wedge_faces[side];
-    faces.push_back(side == 0 ? fl : fr);  // the chart's triangles; the removed one last
-    Blend blend = locate(p, faces);
-    faces.pop_back();
-    if (!blend.corner[0].is_valid()) {
+    // The chart's triangles: the wedge's faces and the removed one.
+    const std::vector<Face>& faces = s.wedge_faces[side];
+    const Face removed = side == 0 ? fl : fr;
+    const RingHit hit = nearest_in_rings(
+        p, v0, v1, s, [&](Face f) { return f == removed || std::find(faces.begin(), faces.end(), f) != faces.end(); });
+    // A face's corner at a vertex is its half-edge pointing there: at the ring's end the one
+    // before `out`, at the neighbour `out`, at the next neighbour the one after.
+    Halfedge corner[3];
+    float weight[3] = {1, 0, 0};
+    if (hit.ring) {
+      const Halfedge out = (*hit.ring)[hit.i].out;
+      corner[0] = m_.prev(out), corner[1] = out, corner[2] = m_.next(out);
+      std::copy_n(hit.weight, 3, weight);
+    } else {
       // No usable triangle (all degenerate): the kept vertex's corner in the removed face.
-      blend.corner[0] = blend.corner[1] = blend.corner[2] = side == 0 ? h : m_.prev(o);
-      blend.weight[0] = 1, blend.weight[1] = blend.weight[2] = 0;
+      corner[0] = corner[1] = corner[2] = side == 0 ? h : m_.prev(o);
     }
     std::size_t offset = 0;
     for (const ChannelArray* c : corner_channels_) {
-      const std::byte* src[3] = {c->element(blend.corner[0].idx()), c->element(blend.corner[1].idx()),
-                                 c->element(blend.corner[2].idx())};
-      blend_element(*c, s.wedge_values.data() + offset + side * c->stride(), src, blend.weight);
+      const std::byte* src[3] = {c->element(corner[0].idx()), c->element(corner[1].idx()), c->element(corner[2].idx())};
+      blend_element(*c, s.wedge_values.data() + offset + side * c->stride(), src, weight);
       offset += 2 * c->stride();
     }
   }
@@ -1643,32 +1667,14 @@ void Decimator::blend_wedges(Vertex kept, const Scratch& s) {
 // placed (RingEntry::position, in the normalized frame): each face around an end is that end
 // and two neighbours in turn, so no face is walked again.
 void Decimator::locate_vertex(Vertex v0, Vertex v1, const Candidate& c, Scratch& s) const {
-  const Vec3d p = local(c.position);
-  double best_distance = std::numeric_limits<double>::infinity();
-  Vertex best[3];
-  Vec3d best_weights{};
-  auto search = [&](Vertex apex, const std::vector<RingEntry>& ring) {
-    const Vec3d at_apex = at(apex);
-    for (std::size_t i = 0, n = ring.size(); i < n; ++i) {
-      if (!ring[i].face.is_valid()) continue;
-      const RingEntry& next = ring[i + 1 == n ? 0 : i + 1];
-      const ClosestPoint cp = closest_point_on_triangle(p, at_apex, ring[i].position, next.position);
-      if (cp.distance < best_distance) {
-        best_distance = cp.distance;
-        best[0] = apex, best[1] = ring[i].vertex, best[2] = next.vertex;
-        best_weights = cp.barycentric;
-      }
-    }
-  };
-  search(v0, s.ring0);
-  search(v1, s.ring1);
+  const RingHit hit = nearest_in_rings(local(c.position), v0, v1, s, [](Face) { return true; });
   s.vertex_blend_size = 0;
-  float weight[3];
-  for (int i = 0; i < 3; ++i) weight[i] = float(std::clamp(best_weights[i], 0.0, 1.0));
-  if (!(weight[0] + weight[1] + weight[2] > 0)) return;
+  if (!hit.ring) return;
+  const std::vector<RingEntry>& ring = *hit.ring;
+  const Vertex corners[3] = {hit.apex, ring[hit.i].vertex, ring[hit.i + 1 == ring.size() ? 0 : hit.i + 1].vertex};
   for (int i = 0; i < 3; ++i) {
-    s.vertex_blend_index[i] = best[i].idx();
-    s.vertex_blend_weight[i] = weight[i];
+    s.vertex_blend_index[i] = corners[i].idx();
+    s.vertex_blend_weight[i] = hit.weight[i];
   }
   s.vertex_blend_size = 3;
 }
@@ -1710,6 +1716,11 @@ Decimator::Collapsed Decimator::apply_collapse(Halfedge h, const Candidate& c, S
       {},
       {Mesh::edge(h), Mesh::edge(m_.next(h)), Mesh::edge(m_.prev(h)), Mesh::edge(m_.next(o)), Mesh::edge(m_.prev(o))},
       int(fl.is_valid()) + int(fr.is_valid())};
+  // With no seam at either end or at the opposite corners, every corner at the kept vertex
+  // takes the one merged wedge's value and the others keep theirs: no seam can appear, so
+  // nothing needs classifying afterwards.
+  auto seam_at = [&](Vertex v) { return v.is_valid() && (vd_[v.idx()].flags & kSeamBits); };
+  const bool near_seam = seam_mode_ && (seam_at(v0) || seam_at(v1) || seam_at(vl) || seam_at(vr));
 
   if (!corner_channels_.empty()) gather_wedges(h, c.position, s);
   // Located before the collapse, while the old triangles exist; written after it.
@@ -1753,7 +1764,7 @@ Decimator::Collapsed Decimator::apply_collapse(Halfedge h, const Candidate& c, S
   // The kept vertex is on the boundary when either end was, and stays locked when it was (the
   // removed end never is); vl and vr keep their status.
   d1.flags = (d0.flags | d1.flags) & (kBoundary | kLocked);
-  if (seam_mode_) {
+  if (near_seam) {
     d1.flags |= classify(v1);
     for (int i = 0; i < 2; ++i) {
       const Vertex v = i == 0 ? vl : vr;

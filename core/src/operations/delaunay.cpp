@@ -65,9 +65,7 @@ struct Seams {
     flipped = m.face_properties().get<bool>(provenance::kFlipped);
   }
 
-  bool differ(const ChannelArray* c, Index a, Index b) const {
-    return std::memcmp(c->element(a), c->element(b), c->stride()) != 0;
-  }
+  bool differ(const ChannelArray* c, Index a, Index b) const { return !c->same(a, b); }
 
   bool at(const Mesh& m, const Quad& q) const {
     const Face f0 = m.face(q.h0), f1 = m.face(q.h1);

@@ -225,9 +225,7 @@ void Remesher::classify() {
     if (a.type() == typeid(ChannelArray) && !a.is_internal())
       face_channels.push_back(static_cast<const ChannelArray*>(&a));
   }
-  auto same = [](const ChannelArray* c, Index a, Index b) {
-    return std::memcmp(c->element(a), c->element(b), c->stride()) == 0;
-  };
+  auto same = [](const ChannelArray* c, Index a, Index b) { return c->same(a, b); };
 
   const std::vector<std::uint8_t> selected =
       options_.selection_only ? detail::selected_faces(mesh_) : std::vector<std::uint8_t>();
