@@ -550,8 +550,12 @@ class Decimator {
     Index vertex_blend_index[3];
     float vertex_blend_weight[3];
     int vertex_blend_size = 0;
-    std::vector<Face> wedge_faces[2];     // faces whose corner at the kept vertex joins wedge l / r
-    std::vector<std::byte> wedge_values;  // new corner values: [wedge l, wedge r] per channel
+    struct WedgeFace {
+      Face face;
+      Halfedge corner;  // its corner at the collapsing end, before the collapse
+    };
+    std::vector<WedgeFace> wedge_faces[2];  // faces whose corner at the kept vertex joins wedge l / r
+    std::vector<std::byte> wedge_values;    // new corner values: [wedge l, wedge r] per channel
     bool wedge_present[2] = {false, false};
     Index interp_index[2];
     float interp_weight[2];
@@ -1578,7 +1582,7 @@ void Decimator::gather_wedges(Halfedge h, const Point& target, Scratch& s) const
 
   // Walks the fan from `start` (an outgoing half-edge whose face holds corner `corner`),
   // rotating one way, while corners stay equal; stops at a hole or at `stop`.
-  auto walk = [&](Halfedge start, Halfedge corner, bool ccw, Face stop, std::vector<Face>& out) {
+  auto walk = [&](Halfedge start, Halfedge corner, bool ccw, Face stop, std::vector<Scratch::WedgeFace>& out) {
     Halfedge x = start;
     for (;;) {
       x = ccw ? m_.ccw_rotated(x) : m_.cw_rotated(x);
@@ -1586,7 +1590,7 @@ void Decimator::gather_wedges(Halfedge h, const Point& target, Scratch& s) const
       if (x == start || !f.is_valid() || f == stop) return;
       const Halfedge c = m_.prev(x);
       if (!corners_equal(c, corner)) return;
-      out.push_back(f);
+      out.push_back({f, c});
       corner = c;
     }
   };
@@ -1618,10 +1622,11 @@ void Decimator::gather_wedges(Halfedge h, const Point& target, Scratch& s) const
       continue;
     }
     // The chart's triangles: the wedge's faces and the removed one.
-    const std::vector<Face>& faces = s.wedge_faces[side];
+    const std::vector<Scratch::WedgeFace>& faces = s.wedge_faces[side];
     const Face removed = side == 0 ? fl : fr;
-    const RingHit hit = nearest_in_rings(
-        p, v0, v1, s, [&](Face f) { return f == removed || std::find(faces.begin(), faces.end(), f) != faces.end(); });
+    const RingHit hit = nearest_in_rings(p, v0, v1, s, [&](Face f) {
+      return f == removed || std::any_of(faces.begin(), faces.end(), [f](const auto& w) { return w.face == f; });
+    });
     // A face's corner at a vertex is its half-edge pointing there: at the ring's end the one
     // before `out`, at the neighbour `out`, at the next neighbour the one after.
     Halfedge corner[3];
@@ -1647,10 +1652,15 @@ void Decimator::gather_wedges(Halfedge h, const Point& target, Scratch& s) const
 void Decimator::blend_wedges(Vertex kept, const Scratch& s) {
   for (int side = 0; side < 2; ++side) {
     if (!s.wedge_present[side]) continue;
-    for (Face f : s.wedge_faces[side]) {
-      if (m_.is_deleted(f)) continue;
-      Halfedge x = m_.halfedge(f);
-      while (m_.to_vertex(x) != kept) x = m_.next(x);
+    for (const Scratch::WedgeFace& w : s.wedge_faces[side]) {
+      if (m_.is_deleted(w.face)) continue;
+      // The corner gather_wedges() saw, unless the collapse moved it (the half-edges of the
+      // edges it merges may be renumbered): then the face is walked to find it.
+      Halfedge x = w.corner;
+      if (m_.is_deleted(Mesh::edge(x)) || m_.face(x) != w.face || m_.to_vertex(x) != kept) {
+        x = m_.halfedge(w.face);
+        while (m_.to_vertex(x) != kept) x = m_.next(x);
+      }
       std::size_t offset = 0;
       for (ChannelArray* c : corner_channels_) {
         std::memcpy(c->element(x.idx()), s.wedge_values.data() + offset + side * c->stride(), c->stride());
