@@ -62,7 +62,6 @@ struct Quadric {
     g0 += q.g0, g1 += q.g1, g2 += q.g2, k += q.k, weight += q.weight;
     return *this;
   }
-  friend Quadric operator+(Quadric a, const Quadric& b) { return a += b; }
   //! Every plane's weight times f.
   Quadric& operator*=(double f) {
     a00 *= f, a01 *= f, a02 *= f, a11 *= f, a12 *= f, a22 *= f;
