@@ -473,7 +473,6 @@ class Decimator {
   Collapsed apply_collapse(Halfedge h, const Candidate& c, Scratch& s, Mesh::Deletions& tally);
   // apply_collapse() and what follows in w's queue; returns the number of faces removed.
   int collapse(Halfedge h, const Candidate& c, Worker& w);
-  // Barycentric coordinates of a point in a triangle, by its corner half-edges.
   struct RingEntry;
   // A face around one end of the collapse, as check() walked it: the end (apex) and entries i
   // and i + 1 of its ring, with barycentric weights in that order.
@@ -1482,7 +1481,7 @@ Decimator::Refusal Decimator::check(Halfedge h, const Point& target, Scratch& s,
     if (vr.is_valid()) s.worst_old = std::min(s.worst_old, triangle_quality(p1, p0, at(vr)));
   }
   auto faces_ok = [&](Vertex v, std::vector<RingEntry>& ring) {
-    for (RingEntry& r : ring) r.position = at(r.vertex);  // locate_vertex() reads them too
+    for (RingEntry& r : ring) r.position = at(r.vertex);  // nearest_in_rings() reads them too
     const Vec3d apex = at(v);
     const std::size_t n = ring.size();
     for (std::size_t i = 0; i < n; ++i) {
