@@ -27,25 +27,34 @@ def option(name, default):
     return type(default)(rest[rest.index(name) + 1]) if name in rest else default
 
 
+def places(me):
+    """3.5+ keeps the vertices' places as the "position" attribute, copied in one go."""
+    position = me.attributes.get("position")
+    return (position.data, "vector") if position is not None else (me.vertices, "co")
+
+
 def read_floor(me):
     """Positions and loops out of Blender by the fastest way the running Blender has: 4.0+
     keeps the corners' vertices as the ".corner_vert" attribute, read in one copy, and the
-    polygons' loops in order; 3.x reads the loops' property."""
+    polygons' loops in order; 3.x reads the loops' property. The mesh's own index properties
+    (loop starts and totals, loop vertices) are unsigned: foreach copies them whole only into
+    uint32 buffers."""
     nv, nl, nf = len(me.vertices), len(me.loops), len(me.polygons)
     positions = np.empty(nv * 3, np.float32)
-    me.vertices.foreach_get("co", positions)
+    collection, prop = places(me)
+    collection.foreach_get(prop, positions)
     corners = np.empty(nl, np.int32)
     corner_vert = me.attributes.get(".corner_vert")
     if corner_vert is not None:
-        starts = np.empty(nf, np.int32)
+        starts = np.empty(nf, np.uint32)
         me.polygons.foreach_get("loop_start", starts)
         sizes = np.diff(np.append(starts, np.int32(nl))).astype(np.int32)
         corner_vert.data.foreach_get("value", corners)
     else:
-        sizes = np.empty(nf, np.int32)
+        sizes = np.empty(nf, np.uint32)
         me.polygons.foreach_get("loop_total", sizes)
-        me.loops.foreach_get("vertex_index", corners)
-    return positions, sizes, corners
+        me.loops.foreach_get("vertex_index", corners.view(np.uint32))
+    return positions, sizes.view(np.int32), corners
 
 
 def write_floor(me, positions, sizes, corners):
@@ -54,14 +63,19 @@ def write_floor(me, positions, sizes, corners):
     me.vertices.add(len(positions) // 3)
     me.loops.add(len(corners))
     me.polygons.add(len(sizes))
-    me.vertices.foreach_set("co", positions)
-    me.loops.foreach_set("vertex_index", corners)
-    starts = np.zeros(len(sizes), np.int32)
+    collection, prop = places(me)
+    collection.foreach_set(prop, positions)
+    corner_vert = me.attributes.get(".corner_vert")
+    if corner_vert is not None:
+        corner_vert.data.foreach_set("value", corners)
+    else:
+        me.loops.foreach_set("vertex_index", corners.view(np.uint32))
+    starts = np.zeros(len(sizes), np.uint32)
     np.cumsum(sizes[:-1], out=starts[1:])
     me.polygons.foreach_set("loop_start", starts)
     if "loop_total" in bpy.types.MeshPolygon.bl_rna.properties and not bpy.types.MeshPolygon.bl_rna.properties[
             "loop_total"].is_readonly:
-        me.polygons.foreach_set("loop_total", sizes)
+        me.polygons.foreach_set("loop_total", sizes.view(np.uint32))
     me.update(calc_edges=True)
 
 
