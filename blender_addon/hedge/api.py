@@ -62,7 +62,7 @@ class Target:
                 bmesh.from_edit_mesh(me).to_mesh(self.scratch)
             me = self.scratch
         self.read_from = me
-        self.data = exchange.read_mesh(me, edges=False)
+        self.data = exchange.read_mesh(me, edges=False, buffers=require_native().SoupBuffers)
         exchange.read_vertex_groups(self.obj, self.obj.data, self.data)
         if carry_keys:
             exchange.read_shape_keys(me, self.data)

@@ -118,49 +118,60 @@ def builtin_attributes():
 
 
 _unsigned = {}
+# The mesh's element collections by their own RNA name ("MeshPolygons"): their elements' RNA.
+_ELEMENTS = {p.srna.identifier: p.fixed_type for p in bpy.types.Mesh.bl_rna.properties
+             if p.type == 'COLLECTION' and p.srna is not None}
 
 
 def _buffer_type(collection, prop, dtype):
     """The buffer type foreach_get/set copy in one go. The mesh's own index properties (loop
     starts and totals, corner and edge vertices, material indices) are ints of subtype
     UNSIGNED, which Blender copies whole only into unsigned 32-bit buffers: an int32 buffer is
-    filled element by element, ten times slower (3.4 to 5.2; attributes' ints take int32)."""
-    if dtype != np.int32 or not len(collection):
+    filled element by element, ten times slower (3.4 to 5.2; attributes' ints take int32).
+    Found from the collection's RNA, not an element's: taking an attribute's first element
+    makes Blender copy a layer it shares (a few ms)."""
+    if dtype != np.int32:
         return dtype
-    rna = collection[0].bl_rna
-    key = (rna.identifier, prop)
+    rna = getattr(collection, "bl_rna", None)
+    key = (rna.identifier if rna is not None else None, prop)
     if key not in _unsigned:
-        p = rna.properties.get(prop)
+        element = _ELEMENTS.get(key[0])
+        p = element.properties.get(prop) if element is not None else None
         _unsigned[key] = p is not None and p.type == 'INT' and p.subtype == 'UNSIGNED'
     return np.uint32 if _unsigned[key] else dtype
 
 
-def _get(collection, prop, n, dtype, components=1):
-    out = np.empty(n * components, _buffer_type(collection, prop, dtype) if n else dtype)
+def _get(collection, prop, n, dtype, components=1, zeros=np.zeros):
+    """n elements (of `components` values each) of every element's `prop`, read into an array
+    that zeros(size, dtype) makes: numpy's by default, or a block of the soup's buffers."""
+    out = zeros(n * components, _buffer_type(collection, prop, dtype))
     if n:
         collection.foreach_get(prop, out)
     out = out.view(dtype)
     return out.reshape(n, components) if components > 1 else out
 
 
-def _builtin(me, name, n, dtype, default, components=1):
+def _builtin(me, name, n, dtype, default, components=1, zeros=np.zeros):
     """A datum Blender keeps as attribute `name`: all `default` when the mesh has none."""
     attribute = me.attributes.get(name)
     if attribute is None:
-        values = np.full(n * components, default, dtype)
+        values = zeros(n * components, dtype)
+        if default:
+            values.fill(default)
         return values.reshape(n, components) if components > 1 else values
-    return _get(attribute.data, "value", n, dtype, components)
+    return _get(attribute.data, "value", n, dtype, components, zeros)
 
 
-def _flag(me, collection, prop, n, dtype):
+def _flag(me, collection, prop, n, dtype, zeros=np.zeros):
     """An element property (selection, hiding, material, smooth shading, edge flags), from its
     attribute where the running Blender keeps one ("sharp_face" holds smooth shading inverted)."""
     name = builtin_attributes().get((collection, prop))
     if name == "sharp_face":
-        return ~_builtin(me, name, n, np.bool_, False)
+        values = _builtin(me, name, n, np.bool_, False, zeros=zeros)
+        return np.logical_not(values, out=values)
     if name is not None:
-        return _builtin(me, name, n, dtype, 0)
-    return _get(getattr(me, collection), prop, n, dtype)
+        return _builtin(me, name, n, dtype, 0, zeros=zeros)
+    return _get(getattr(me, collection), prop, n, dtype, zeros=zeros)
 
 
 def _set(collection, prop, values):
@@ -225,26 +236,45 @@ class MeshData:
         self.vertex_groups = []   # names, in order, when read (read_vertex_groups)
         self.active_group = -1
         self.shape_keys = []      # key block names in order, the reference key first (read_shape_keys)
+        self.buffers = None       # the native SoupBuffers the soup's arrays lie in, if any
 
 
-def read_mesh(me, edges=True):
+def read_mesh(me, edges=True, buffers=None):
     """Reads a bpy.types.Mesh (object mode data) into a MeshData; its edges' data too unless
-    `edges` is False (read_edges() then reads them before writing back)."""
+    `edges` is False (read_edges() then reads them before writing back). Given `buffers` (the
+    native module's SoupBuffers), the soup's arrays are read into buffers it makes, which an
+    operation then reads where they lie instead of copying them."""
     d = MeshData()
     nv, nl, nf, ne = len(me.vertices), len(me.loops), len(me.polygons), len(me.edges)
-    positions = _get(*_positions(me), nv, np.float32, 3)
+    if buffers is None:
+        zeros = own_positions = own_sizes = own_corners = np.zeros
+    else:
+        into = buffers(nv, nf, nl)
+
+        def zeros(size, dtype):
+            return into.zeros(size, np.dtype(dtype))
+
+        def inside(block):
+            return lambda size, dtype: block.reshape(-1).view(dtype)
+
+        own_positions, own_sizes, own_corners = inside(into.positions), inside(into.face_sizes), inside(into.corners)
+        d.buffers = into
+    positions = _get(*_positions(me), nv, np.float32, 3, own_positions)
     builtin = builtin_attributes()
     loop_start = _get(me.polygons, "loop_start", nf, np.int32)
-    loop_total = np.diff(np.append(loop_start, np.int32(nl))).astype(np.int32)
+    loop_total = own_sizes(nf, np.int32)
+    loop_total[:-1] = loop_start[1:] - loop_start[:-1]
+    if nf:
+        loop_total[-1] = nl - loop_start[-1]
     # Starts rising from 0 are the loops in polygon order, each polygon's size the gap to the
     # next start; otherwise (possible before 3.6) the sizes are read and the order checked.
     in_order = not nf or (loop_start[0] == 0 and np.all(loop_total > 0))
     if not in_order:
-        loop_total = _get(me.polygons, "loop_total", nf, np.int32)
+        _get(me.polygons, "loop_total", nf, np.int32, zeros=lambda size, dtype: loop_total.view(dtype))
     if ".corner_vert" in builtin:
-        vertex_index = _builtin(me, ".corner_vert", nl, np.int32, 0)
+        vertex_index = _builtin(me, ".corner_vert", nl, np.int32, 0, zeros=own_corners)
     else:
-        vertex_index = _get(me.loops, "vertex_index", nl, np.int32)
+        vertex_index = _get(me.loops, "vertex_index", nl, np.int32, zeros=own_corners)
     corners = vertex_index
     if not in_order:
         starts = np.zeros(nf, np.int64)
@@ -260,7 +290,8 @@ def read_mesh(me, edges=True):
         return values if d.loop_order is None else values[d.loop_order]
 
     for layer in me.uv_layers:
-        channels.append(("uv:" + layer.name, "corner", corner_values(_get(layer.data, "uv", nl, np.float32, 2))))
+        uv = _get(layer.data, "uv", nl, np.float32, 2, zeros)
+        channels.append(("uv:" + layer.name, "corner", corner_values(uv)))
         d.uv_names.append(layer.name)
     if me.uv_layers.active is not None:
         d.active_uv = me.uv_layers.active.name
@@ -296,7 +327,7 @@ def read_mesh(me, edges=True):
         if domain is None:
             d.not_carried.append(f"attribute {name} ({attr.domain})")
             continue
-        values = _get(attr.data, prop, sizes[domain], dtype, comps)
+        values = _get(attr.data, prop, sizes[domain], dtype, comps, zeros)
         if dtype == np.bool_:
             values = values.view(np.uint8)
         if domain == "corner":
@@ -308,9 +339,9 @@ def read_mesh(me, edges=True):
             channels.append((ATTRIBUTE_PREFIX + name, domain, values))
             d.attributes.append((name, attr.data_type, attr.domain))
 
-    material = _flag(me, "polygons", "material_index", nf, np.int32)
-    smooth = _flag(me, "polygons", "use_smooth", nf, np.bool_)
-    flags = [_flag(me, collection, prop, n, np.bool_) for collection, prop, n in (
+    material = _flag(me, "polygons", "material_index", nf, np.int32, zeros)
+    smooth = _flag(me, "polygons", "use_smooth", nf, np.bool_, zeros)
+    flags = [_flag(me, collection, prop, n, np.bool_, zeros) for collection, prop, n in (
         ("vertices", "select", nv), ("polygons", "select", nf), ("vertices", "hide", nv), ("polygons", "hide", nf))]
     channels.append(("material", "face", material))
     channels.append(("smooth", "face", smooth.view(np.uint8)))
@@ -324,6 +355,8 @@ def read_mesh(me, edges=True):
     if me.has_custom_normals:
         d.not_carried.append("custom split normals")
     d.soup = {"positions": positions, "face_sizes": loop_total, "corners": corners, "channels": channels}
+    if d.buffers is not None:
+        d.soup["buffers"] = d.buffers
     if edges:
         read_edges(me, d)
     return d
@@ -681,6 +714,9 @@ def repeated_vertex_faces(sizes, corners):
     """Faces that visit a vertex twice in a row (all such triangles), which Blender must not hold."""
     if len(sizes) == 0:
         return 0
+    if len(corners) == 3 * len(sizes) and np.all(sizes == 3):  # triangles: no walk around faces
+        t = corners.reshape(-1, 3)
+        return int(np.count_nonzero((t[:, 0] == t[:, 1]) | (t[:, 1] == t[:, 2]) | (t[:, 2] == t[:, 0])))
     starts = np.zeros(len(sizes), np.int64)
     np.cumsum(sizes[:-1], out=starts[1:])
     nxt = np.arange(1, len(corners) + 1)

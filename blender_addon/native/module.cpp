@@ -5,6 +5,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <atomic>
 #include <condition_variable>
 #include <cstring>
@@ -118,26 +119,44 @@ Domain domain_of(const std::string& name) {
 // A C-contiguous view of any array-like; the buffer is read in place (one memcpy into the Soup).
 py::array contiguous(const py::handle& obj) { return py::array::ensure(obj, py::array::c_style); }
 
-Soup soup_from(const py::dict& mesh) {
-  Soup soup;
+// Copies a's elements into out, unless they are there already (a is a view of out). A `fixed`
+// vector (a SoupBuffers' own, which Python may hold views of) is never reallocated.
+template <class T>
+void take(const char* key, const py::array& a, std::vector<T>& out, bool fixed) {
+  const auto* first = static_cast<const T*>(a.data());
+  const auto n = static_cast<std::size_t>(a.nbytes()) / sizeof(T);
+  if (first == out.data() && n == out.size()) return;
+  if (fixed && n != out.size())
+    throw Error(std::string(key) + ": " + std::to_string(n) + " elements, the buffers hold " +
+                std::to_string(out.size()));
+  out.assign(first, first + n);  // one copy; resize() then memcpy would write every element twice
+}
+
+// Blocks handed to Python for channels (SoupBuffers.zeros), not yet in a soup.
+using Blocks = std::vector<std::vector<std::byte>>;
+
+// Fills `soup` from a mesh dict. An array that is already the soup's own (positions, face sizes,
+// corners), or one of `spare`'s blocks (a channel), is taken where it lies; any other is copied.
+// Given `spare` (the soup is a SoupBuffers'), no memory the soup or `spare` holds is freed.
+void read_soup(const py::dict& mesh, Soup& soup, Blocks* spare) {
   {
     py::array p = contiguous(mesh["positions"]);
     if (!p || p.dtype().kind() != 'f' || p.itemsize() != 4) throw Error("positions must be float32");
     if (p.size() % 3) throw Error("positions: expected rows of 3");
-    soup.positions.resize(static_cast<std::size_t>(p.size() / 3));
     static_assert(sizeof(Point) == 3 * sizeof(float));
-    if (p.size()) std::memcpy(soup.positions.data(), p.data(), static_cast<std::size_t>(p.nbytes()));
+    take("positions", p, soup.positions, spare != nullptr);
   }
   auto indices = [&](const char* key, std::vector<std::uint32_t>& out) {
     py::array a = contiguous(mesh[key]);
     if (!a || (a.dtype().kind() != 'i' && a.dtype().kind() != 'u') || a.itemsize() != 4)
       throw Error(std::string(key) + " must be int32 or uint32");
-    // assign() copies once; resize() then memcpy would write every element twice.
-    const auto* first = static_cast<const std::uint32_t*>(a.data());
-    out.assign(first, first + a.size());
+    take(key, a, out, spare != nullptr);
   };
   indices("face_sizes", soup.face_sizes);
   indices("corners", soup.corners);
+  if (spare)  // channels taken before go back with the blocks, so that none is ever freed
+    for (Channel& c : soup.channels) spare->push_back(std::move(c.data));
+  soup.channels.clear();
   if (mesh.contains("channels")) {
     for (const py::handle& item : mesh["channels"]) {
       auto t = item.cast<py::tuple>();
@@ -152,13 +171,79 @@ Soup soup_from(const py::dict& mesh) {
                                    : (n ? static_cast<int>(static_cast<std::size_t>(a.size()) / n) : 1);
       if (c.components < 1) c.components = 1;
       const auto* first = static_cast<const std::byte*>(a.data());
-      c.data.assign(first, first + a.nbytes());
+      const auto bytes = static_cast<std::size_t>(a.nbytes());
+      auto block = spare ? std::find_if(spare->begin(), spare->end(),
+                                        [&](const auto& b) { return b.data() == first && b.size() == bytes; })
+                         : Blocks::iterator{};
+      if (spare && block != spare->end()) {
+        c.data = std::move(*block);
+        spare->erase(block);
+      } else {
+        c.data.assign(first, first + bytes);
+      }
       soup.channels.push_back(std::move(c));
     }
   }
   soup.check();
+}
+
+Soup soup_from(const py::dict& mesh) {
+  Soup soup;
+  read_soup(mesh, soup, nullptr);
   return soup;
 }
+
+// Arrays that Python fills where they lie (Blender's foreach_get writes straight into them)
+// and an operation then reads there: a mesh dict naming these buffers under "buffers" crosses
+// into the native side without copying them. Its other arrays (a reordered copy, a computed
+// channel) are copied as always. The views handed out keep the buffers alive, and no block
+// is freed before the buffers are, so a view never outlives its memory.
+class SoupBuffers {
+ public:
+  SoupBuffers(std::size_t vertices, std::size_t faces, std::size_t corners) {
+    soup_.positions.resize(vertices);
+    soup_.face_sizes.resize(faces);
+    soup_.corners.resize(corners);
+  }
+  // The soup the mesh dict describes, refused while an operation reads these buffers.
+  const Soup& read(const py::dict& mesh) {
+    if (readers_.load() > 0) throw Error("the mesh's buffers are in use by a running operation");
+    read_soup(mesh, soup_, &spare_);
+    return soup_;
+  }
+  const Soup& soup() const { return soup_; }
+  Soup& soup() { return soup_; }
+  std::byte* block(std::size_t bytes) { return spare_.emplace_back(bytes).data(); }
+  std::atomic<int>& readers() { return readers_; }
+
+ private:
+  Soup soup_;
+  Blocks spare_;
+  std::atomic<int> readers_{0};
+};
+
+// A numpy view of `data`, which lives as long as `owner` (the SoupBuffers) does.
+template <class T>
+py::array view(T* data, std::vector<py::ssize_t> shape, const py::object& owner,
+               const py::dtype& dt = py::dtype::of<T>()) {
+  return py::array(dt, std::move(shape), {}, data, owner);
+}
+
+// The buffers an operation reads, counted as read until it lets go of them.
+class Lease {
+ public:
+  Lease() = default;
+  explicit Lease(std::shared_ptr<SoupBuffers> b) : buffers_(std::move(b)) { ++buffers_->readers(); }
+  Lease(Lease&& o) noexcept : buffers_(std::move(o.buffers_)) {}
+  Lease& operator=(Lease&&) = delete;
+  ~Lease() {
+    if (buffers_) --buffers_->readers();
+  }
+  const SoupBuffers* get() const { return buffers_.get(); }
+
+ private:
+  std::shared_ptr<SoupBuffers> buffers_;
+};
 
 // Hands a vector to numpy without copying: the array owns it through a capsule.
 template <class T>
@@ -230,14 +315,21 @@ std::map<std::string, Value> values_from(const Operation& op, const py::dict& pa
 
 struct Prepared {
   const Operation* op;
-  Soup soup;
+  Soup copied;  // the mesh dict's arrays, copied
+  Lease lease;  // or the buffers that hold them, read where they lie
   ParamValues values;
+  const Soup& soup() const { return lease.get() ? lease.get()->soup() : copied; }
 };
 
 Prepared prepare(const std::string& op_id, const py::dict& mesh, const py::dict& params) {
   const Operation& op = find_operation(op_id);
   ParamValues values = resolve_params(op, values_from(op, params));  // refused before any work
-  return {&op, soup_from(mesh), std::move(values)};
+  if (mesh.contains("buffers")) {
+    auto buffers = mesh["buffers"].cast<std::shared_ptr<SoupBuffers>>();
+    buffers->read(mesh);
+    return {&op, Soup{}, Lease(std::move(buffers)), std::move(values)};
+  }
+  return {&op, soup_from(mesh), Lease{}, std::move(values)};
 }
 
 py::tuple finish(RunResult&& result, const Operation& op) {
@@ -259,7 +351,7 @@ py::tuple run(const std::string& op_id, const py::dict& mesh, const py::dict& pa
       };
     Progress prog(cb);
     py::gil_scoped_release nogil;
-    result = run_operation(*p.op, p.soup, p.values, prog);
+    result = run_operation(*p.op, p.soup(), p.values, prog);
   }
   return finish(std::move(result), *p.op);
 }
@@ -280,7 +372,7 @@ class Job {
         return !cancel_.load();
       });
       try {
-        result_ = run_operation(*prepared_.op, prepared_.soup, prepared_.values, prog);
+        result_ = run_operation(*prepared_.op, prepared_.soup(), prepared_.values, prog);
       } catch (...) {
         error_ = std::current_exception();
       }
@@ -408,6 +500,34 @@ PYBIND11_MODULE(_native, m) {
         "build() and extract() with nothing in between (the no-op round trip).");
   m.def("read_mesh", &read_file, py::arg("path"), "Reads OFF/OBJ/PLY/STL with hedge's reader into a mesh dict.");
   m.def("write_mesh", &write_file, py::arg("mesh"), py::arg("path"), "Writes a mesh dict with hedge's writer.");
+  py::class_<SoupBuffers, std::shared_ptr<SoupBuffers>>(
+      m, "SoupBuffers",
+      "Arrays to fill in place for a mesh dict (positions, face_sizes, corners, and blocks for "
+      "channels); a dict naming them under \"buffers\" is read where they lie, not copied.")
+      .def(py::init<std::size_t, std::size_t, std::size_t>(), py::arg("vertices"), py::arg("faces"), py::arg("corners"))
+      .def_property_readonly("positions",
+                             [](py::object self) {
+                               auto& p = self.cast<SoupBuffers&>().soup().positions;
+                               return view(reinterpret_cast<float*>(p.data()), {py::ssize_t(p.size()), 3}, self);
+                             })
+      .def_property_readonly("face_sizes",
+                             [](py::object self) {
+                               auto& f = self.cast<SoupBuffers&>().soup().face_sizes;
+                               return view(f.data(), {py::ssize_t(f.size())}, self, py::dtype::of<std::int32_t>());
+                             })
+      .def_property_readonly("corners",
+                             [](py::object self) {
+                               auto& c = self.cast<SoupBuffers&>().soup().corners;
+                               return view(c.data(), {py::ssize_t(c.size())}, self, py::dtype::of<std::int32_t>());
+                             })
+      .def(
+          "zeros",
+          [](py::object self, py::ssize_t n, const py::dtype& dt) {
+            if (n < 0) throw Error("a block's size cannot be negative");
+            auto bytes = static_cast<std::size_t>(n) * static_cast<std::size_t>(dt.itemsize());
+            return view(self.cast<SoupBuffers&>().block(bytes), {n}, self, dt);
+          },
+          py::arg("n"), py::arg("dtype"), "A new block of n elements (zeros) for a channel.");
   py::class_<Job>(m, "Job")
       .def(py::init<const std::string&, const py::dict&, const py::dict&>(), py::arg("operation"), py::arg("mesh"),
            py::arg("params") = py::dict())

@@ -141,6 +141,38 @@ class RoundTripTest(unittest.TestCase):
             self.assertTrue(np.array_equal(before[key], after[key]), key)
         self.assertEqual(obj.vertex_groups["g"].weight(2), 0.5)
 
+    def test_read_into_buffers(self):
+        """Read into the native module's buffers, the soup is the same as read into numpy's
+        arrays; its big arrays lie in the buffers (an operation reads them without a copy), the
+        same operation gives the same result either way, and the buffers are refused to a
+        second operation while one runs."""
+        obj = add_primitive("monkey")
+        decorate(obj)
+        plain = exchange.read_mesh(obj.data, edges=False)
+        data = exchange.read_mesh(obj.data, edges=False, buffers=native.SoupBuffers)
+        soup, buffers = data.soup, data.soup["buffers"]
+        for key in ("positions", "face_sizes", "corners"):
+            self.assertTrue(np.array_equal(soup[key], plain.soup[key]), key)
+            self.assertTrue(np.shares_memory(soup[key], getattr(buffers, key)), key)
+        self.assertEqual([(n, d) for n, d, _ in soup["channels"]], [(n, d) for n, d, _ in plain.soup["channels"]])
+        for (name, domain, values), (_, _, expected) in zip(soup["channels"], plain.soup["channels"]):
+            self.assertTrue(np.array_equal(values, expected), f"{name} ({domain})")
+            if name in ("uv:UVMap", "material", "selected"):
+                owner = values
+                while isinstance(owner, np.ndarray):
+                    owner = owner.base
+                self.assertIs(owner, buffers, name)
+        params = {"target_ratio": 0.5}
+        in_place, report = native.run("decimate", soup, params)
+        copied, _ = native.run("decimate", plain.soup, params)
+        self.assertGreater(report["collapses"], 0)
+        for key in ("positions", "face_sizes", "corners"):
+            self.assertTrue(np.array_equal(in_place[key], copied[key]), key)
+        job = native.Job("decimate", soup, params)
+        with self.assertRaisesRegex(native.Error, "in use by a running operation"):
+            native.run("decimate", soup, params)
+        job.result()
+
     def test_full_dragon_exchange_time(self):
         path = mesh_path(self, "dragon.ply")
         start = time.perf_counter()
