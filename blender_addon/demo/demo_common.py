@@ -28,13 +28,15 @@ def arguments(add_options):
 
 
 def load_hedge(zip_path):
-    """The hedge package, enabled, or installed from `zip_path` first; an empty scene."""
-    try:
-        hedge_install.enable(quiet=True)
-    except RuntimeError:
-        if not zip_path:
-            sys.exit("the hedge add-on is not installed (./run install, or pass --zip)")
+    """The hedge package installed from `zip_path` (so the demo shows the build it was given,
+    never an older install), or the installed one when no zip is given; an empty scene."""
+    if zip_path:
         hedge_install.install(zip_path)
+    else:
+        try:
+            hedge_install.enable(quiet=True)
+        except RuntimeError:
+            sys.exit("the hedge add-on is not installed (./run install, or pass --zip)")
     import hedge
     for obj in list(bpy.data.objects):
         bpy.data.objects.remove(obj)
