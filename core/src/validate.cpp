@@ -1,36 +1,77 @@
 // The invariant checker. Walks every element once; loops are bounded by the number of
-// half-edges so a corrupted mesh is reported, never looped over forever.
+// half-edges so a corrupted mesh is reported, never looped over forever. Each pass runs over
+// parts of its elements on several threads and reports the failure at the lowest index, the
+// one a single thread checking in order would meet first: the message is the same for any
+// thread count.
 #include "hedge/validate.h"
 
+#include <atomic>
+#include <mutex>
+#include <optional>
 #include <sstream>
+#include <utility>
 #include <vector>
 
 #include "hedge/error.h"
+#include "parallel.h"
 
 namespace hedge {
 namespace {
+
+// What one part of a pass found: its first failure, and the scratch its checks share.
+struct Part {
+  std::optional<std::pair<Index, std::string>> failure;
+  std::vector<Index> seen;  // faces(): the face that last visited each vertex
+
+  template <class... Args>
+  bool fail(Index at, Args&&... args) {
+    std::ostringstream out;
+    (out << ... << args);
+    failure.emplace(at, out.str());
+    return false;
+  }
+};
 
 class Checker {
  public:
   explicit Checker(const Mesh& mesh) : m_(mesh) {}
 
   Validation run() {
-    if (!sizes() || !halfedges() || !faces() || !vertices()) return result_;
+    if (!sizes()) return result_;
+    if (!each(m_.halfedges_size(), [this](Index i, Part& p) { return halfedge(i, p); })) return result_;
+    if (!each(m_.faces_size(), [this](Index i, Part& p) { return face(i, p); })) return result_;
+    count_outgoing();
+    each(m_.vertices_size(), [this](Index i, Part& p) { return vertex(i, p); });
     return result_;
   }
 
  private:
-  template <class... Args>
-  bool fail(Args&&... args) {
-    std::ostringstream out;
-    (out << ... << args);
-    result_ = {false, out.str()};
+  bool fail(std::string message) {
+    result_ = {false, std::move(message)};
     return false;
+  }
+
+  // check(i, part) for every i in [0, n), parts of the range on several threads; true when
+  // every check passes, else false with the message of the failure at the lowest index.
+  template <class Check>
+  bool each(std::size_t n, Check&& check) {
+    std::mutex mutex;
+    std::optional<std::pair<Index, std::string>> first;
+    parallel_for(n, 0, [&](std::size_t begin, std::size_t end) {
+      Part part;
+      for (std::size_t i = begin; i < end; ++i)
+        if (!check(static_cast<Index>(i), part)) break;
+      if (!part.failure) return;
+      std::lock_guard lock(mutex);
+      if (!first || part.failure->first < first->first) first = std::move(part.failure);
+    });
+    return first ? fail(std::move(first->second)) : true;
   }
 
   bool sizes() {
     if (m_.positions().size() != m_.vertices_size())
-      return fail("positions: ", m_.positions().size(), " entries for ", m_.vertices_size(), " vertices");
+      return fail("positions: " + std::to_string(m_.positions().size()) + " entries for " +
+                  std::to_string(m_.vertices_size()) + " vertices");
     if (m_.vertex_properties().size() != m_.vertices_size() || m_.halfedge_properties().size() != m_.halfedges_size() ||
         m_.edge_properties().size() != m_.edges_size() || m_.face_properties().size() != m_.faces_size())
       return fail("properties: a container's length differs from its element count");
@@ -41,90 +82,104 @@ class Checker {
   bool in_range(Vertex v) const { return v.is_valid() && v.idx() < m_.vertices_size(); }
   bool in_range(Face f) const { return f.is_valid() && f.idx() < m_.faces_size(); }
 
-  bool halfedges() {
-    for (Index i = 0; i < m_.halfedges_size(); ++i) {
-      Halfedge h(i);
-      if (m_.is_deleted(h)) continue;
-      Halfedge n = m_.next(h), p = m_.prev(h);
+  bool halfedge(Index i, Part& part) const {
+    Halfedge h(i);
+    if (m_.is_deleted(h)) return true;
+    Halfedge n = m_.next(h), p = m_.prev(h);
+    Vertex v = m_.to_vertex(h);
+    Face f = m_.face(h);
+    if (!in_range(n) || !in_range(p)) return part.fail(i, "half-edge ", i, ": next or prev is not a valid half-edge");
+    if (m_.is_deleted(n) || m_.is_deleted(p)) return part.fail(i, "half-edge ", i, ": next or prev is deleted");
+    if (m_.prev(n) != h) return part.fail(i, "half-edge ", i, ": prev(next(h)) is ", m_.prev(n).idx());
+    if (m_.next(p) != h) return part.fail(i, "half-edge ", i, ": next(prev(h)) is ", m_.next(p).idx());
+    if (!in_range(v) || m_.is_deleted(v)) return part.fail(i, "half-edge ", i, ": target vertex is invalid or deleted");
+    if (f.is_valid() && (!in_range(f) || m_.is_deleted(f)))
+      return part.fail(i, "half-edge ", i, ": face is out of range or deleted");
+    if (m_.face(n) != f) return part.fail(i, "half-edge ", i, ": next(h) lies in another face");
+    if (m_.to_vertex(p) != m_.from_vertex(h))
+      return part.fail(i, "half-edge ", i, ": to_vertex(prev(h)) is not the origin of h (to_vertex(opposite(h)))");
+    if (v == m_.from_vertex(h)) return part.fail(i, "half-edge ", i, ": starts and ends at vertex ", v.idx());
+    if (m_.is_boundary(h) && m_.is_boundary(Mesh::opposite(h)))
+      return part.fail(i, "edge ", i / 2, ": has no face on either side");
+    return true;
+  }
+
+  bool face(Index i, Part& part) const {
+    Face f(i);
+    if (m_.is_deleted(f)) return true;
+    if (part.seen.empty()) part.seen.assign(m_.vertices_size(), kInvalidIndex);
+    const std::size_t bound = m_.halfedges_size();
+    Halfedge start = m_.halfedge(f);
+    if (!in_range(start) || m_.is_deleted(start))
+      return part.fail(i, "face ", i, ": its half-edge is invalid or deleted");
+    if (m_.face(start) != f) return part.fail(i, "face ", i, ": face(halfedge(f)) is not f");
+    std::size_t n = 0;
+    Halfedge h = start;
+    do {
       Vertex v = m_.to_vertex(h);
-      Face f = m_.face(h);
-      if (!in_range(n) || !in_range(p)) return fail("half-edge ", i, ": next or prev is not a valid half-edge");
-      if (m_.is_deleted(n) || m_.is_deleted(p)) return fail("half-edge ", i, ": next or prev is deleted");
-      if (m_.prev(n) != h) return fail("half-edge ", i, ": prev(next(h)) is ", m_.prev(n).idx());
-      if (m_.next(p) != h) return fail("half-edge ", i, ": next(prev(h)) is ", m_.next(p).idx());
-      if (!in_range(v) || m_.is_deleted(v)) return fail("half-edge ", i, ": target vertex is invalid or deleted");
-      if (f.is_valid() && (!in_range(f) || m_.is_deleted(f)))
-        return fail("half-edge ", i, ": face is out of range or deleted");
-      if (m_.face(n) != f) return fail("half-edge ", i, ": next(h) lies in another face");
-      if (m_.to_vertex(p) != m_.from_vertex(h))
-        return fail("half-edge ", i, ": to_vertex(prev(h)) is not the origin of h (to_vertex(opposite(h)))");
-      if (v == m_.from_vertex(h)) return fail("half-edge ", i, ": starts and ends at vertex ", v.idx());
-      if (m_.is_boundary(h) && m_.is_boundary(Mesh::opposite(h)))
-        return fail("edge ", i / 2, ": has no face on either side");
-    }
+      if (part.seen[v.idx()] == i) return part.fail(i, "face ", i, ": visits vertex ", v.idx(), " twice");
+      part.seen[v.idx()] = i;
+      h = m_.next(h);
+      if (++n > bound) return part.fail(i, "face ", i, ": its loop does not close");
+    } while (h != start);
+    if (n < 3) return part.fail(i, "face ", i, ": has ", n, " corners, fewer than 3");
     return true;
   }
 
-  bool faces() {
-    std::vector<Index> seen(m_.vertices_size(), kInvalidIndex);
-    const std::size_t bound = m_.halfedges_size();
-    for (Index i = 0; i < m_.faces_size(); ++i) {
-      Face f(i);
-      if (m_.is_deleted(f)) continue;
-      Halfedge start = m_.halfedge(f);
-      if (!in_range(start) || m_.is_deleted(start)) return fail("face ", i, ": its half-edge is invalid or deleted");
-      if (m_.face(start) != f) return fail("face ", i, ": face(halfedge(f)) is not f");
-      std::size_t n = 0;
-      Halfedge h = start;
-      do {
-        Vertex v = m_.to_vertex(h);
-        if (seen[v.idx()] == i) return fail("face ", i, ": visits vertex ", v.idx(), " twice");
-        seen[v.idx()] = i;
-        h = m_.next(h);
-        if (++n > bound) return fail("face ", i, ": its loop does not close");
-      } while (h != start);
-      if (n < 3) return fail("face ", i, ": has ", n, " corners, fewer than 3");
-    }
-    return true;
+  // How many live half-edges leave each vertex, counted on several threads (atomically only
+  // when the count is split).
+  void count_outgoing() {
+    const std::size_t n = m_.halfedges_size();
+    outgoing_.assign(m_.vertices_size(), 0);
+    parallel_for(n, 0, [this, n](std::size_t begin, std::size_t end) {
+      const bool alone = begin == 0 && end == n;
+      for (std::size_t i = begin; i < end; ++i) {
+        const Halfedge h(static_cast<Index>(i));
+        if (m_.is_deleted(h)) continue;
+        Index& count = outgoing_[m_.from_vertex(h).idx()];
+        if (alone)
+          ++count;
+        else
+          std::atomic_ref(count).fetch_add(1, std::memory_order_relaxed);
+      }
+    });
   }
 
-  bool vertices() {
-    // Every vertex must be manifold: rotating around it reaches all its outgoing half-edges.
-    std::vector<Index> outgoing(m_.vertices_size(), 0);
-    for (Index i = 0; i < m_.halfedges_size(); ++i)
-      if (!m_.is_deleted(Halfedge(i))) ++outgoing[m_.from_vertex(Halfedge(i)).idx()];
-    const std::size_t bound = m_.halfedges_size();
-    for (Index i = 0; i < m_.vertices_size(); ++i) {
-      Vertex v(i);
-      if (m_.is_deleted(v)) {
-        if (outgoing[i]) return fail("vertex ", i, ": deleted but still has ", outgoing[i], " edges");
-        continue;
-      }
-      Halfedge start = m_.halfedge(v);
-      if (!start.is_valid()) {
-        if (outgoing[i]) return fail("vertex ", i, ": has no half-edge but ", outgoing[i], " edges");
-        continue;
-      }
-      if (!in_range(start) || m_.is_deleted(start)) return fail("vertex ", i, ": its half-edge is invalid or deleted");
-      if (m_.from_vertex(start) != v) return fail("vertex ", i, ": halfedge(v) does not start at v");
-      std::size_t n = 0, boundary = 0;
-      Halfedge h = start;
-      do {
-        if (m_.from_vertex(h) != v) return fail("vertex ", i, ": rotation reached a half-edge not leaving it");
-        if (m_.is_boundary(h)) ++boundary;
-        h = m_.ccw_rotated(h);
-        if (++n > bound) return fail("vertex ", i, ": rotation does not close");
-      } while (h != start);
-      if (n != outgoing[i])
-        return fail("vertex ", i, ": non-manifold, its fan holds ", n, " of its ", outgoing[i], " edges");
-      if (boundary > 1) return fail("vertex ", i, ": non-manifold, ", boundary, " boundary gaps");
-      if (boundary == 1 && !m_.is_boundary(start))
-        return fail("vertex ", i, ": on the boundary but halfedge(v) is not its boundary half-edge");
+  // Every vertex must be manifold: rotating around it reaches all its outgoing half-edges.
+  bool vertex(Index i, Part& part) const {
+    Vertex v(i);
+    const Index outgoing = outgoing_[i];
+    if (m_.is_deleted(v)) {
+      if (outgoing) return part.fail(i, "vertex ", i, ": deleted but still has ", outgoing, " edges");
+      return true;
     }
+    Halfedge start = m_.halfedge(v);
+    if (!start.is_valid()) {
+      if (outgoing) return part.fail(i, "vertex ", i, ": has no half-edge but ", outgoing, " edges");
+      return true;
+    }
+    if (!in_range(start) || m_.is_deleted(start))
+      return part.fail(i, "vertex ", i, ": its half-edge is invalid or deleted");
+    if (m_.from_vertex(start) != v) return part.fail(i, "vertex ", i, ": halfedge(v) does not start at v");
+    const std::size_t bound = m_.halfedges_size();
+    std::size_t n = 0, boundary = 0;
+    Halfedge h = start;
+    do {
+      if (m_.from_vertex(h) != v) return part.fail(i, "vertex ", i, ": rotation reached a half-edge not leaving it");
+      if (m_.is_boundary(h)) ++boundary;
+      h = m_.ccw_rotated(h);
+      if (++n > bound) return part.fail(i, "vertex ", i, ": rotation does not close");
+    } while (h != start);
+    if (n != outgoing)
+      return part.fail(i, "vertex ", i, ": non-manifold, its fan holds ", n, " of its ", outgoing, " edges");
+    if (boundary > 1) return part.fail(i, "vertex ", i, ": non-manifold, ", boundary, " boundary gaps");
+    if (boundary == 1 && !m_.is_boundary(start))
+      return part.fail(i, "vertex ", i, ": on the boundary but halfedge(v) is not its boundary half-edge");
     return true;
   }
 
   const Mesh& m_;
+  std::vector<Index> outgoing_;
   Validation result_;
 };
 

@@ -5,14 +5,20 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <filesystem>
 #include <map>
 #include <string>
+#include <tuple>
 #include <vector>
 
+#include "hedge/build.h"
 #include "hedge/error.h"
+#include "hedge/io.h"
 #include "hedge/provenance.h"
+#include "hedge/threads.h"
 #include "hedge/topology.h"
 #include "hedge/validate.h"
+#include "parallel.h"
 #include "test_meshes.h"
 
 namespace hedge {
@@ -378,6 +384,42 @@ TEST(Mesh, ValidateNamesTheBrokenInvariant) {
   EXPECT_FALSE(validate(n));
   EXPECT_NE(validate(n).message.find("vertex 0"), std::string::npos) << validate(n).message;
   EXPECT_THROW(check_valid(n, "test"), Error);
+}
+
+// validate() checks each pass on several threads: whatever their number, it names the first
+// broken element in index order, as one thread checking in order does.
+TEST(Mesh, ValidateNamesTheFirstBreakOnAnyThreadCount) {
+  const std::string path = std::string(HEDGE_MESH_DIR) + "/bunny.off";
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "bunny.off not found in " << HEDGE_MESH_DIR;
+  const Mesh bunny = build(read_mesh(path)).mesh;
+  ASSERT_TRUE(validate(bunny)) << validate(bunny).message;
+  const Index nv = static_cast<Index>(bunny.vertices_size()), nh = static_cast<Index>(bunny.halfedges_size());
+  auto broken_vertices = [&] {  // two vertices far apart whose half-edge does not leave them
+    Mesh m = bunny;
+    for (Index v : {nv - 7, Index(11)}) m.set_halfedge(Vertex(v), m.next(m.halfedge(Vertex(v))));
+    return m;
+  };
+  auto broken_halfedges = [&] {  // two loops that skip a corner, far apart
+    Mesh m = bunny;
+    for (Index h : {nh - 40, Index(30)}) m.set_next(Halfedge(h), m.next(m.next(Halfedge(h))));
+    return m;
+  };
+  for (const auto& [what, mesh, expected] : {std::tuple{"vertices", broken_vertices(), std::string("vertex 11:")},
+                                             std::tuple{"half-edges", broken_halfedges(), std::string("half-edge ")}}) {
+    set_thread_count(1);
+    const Validation one = validate(mesh);
+    ASSERT_FALSE(one) << what;
+    EXPECT_EQ(one.message.rfind(expected, 0), 0u) << what << ": " << one.message;
+    for (unsigned threads : {2u, 3u, 8u}) {
+      set_thread_count(threads);
+      testing::set_parallel_grain(64);
+      const std::size_t splits = testing::parallel_splits();
+      EXPECT_EQ(validate(mesh).message, one.message) << what << ", " << threads << " threads";
+      EXPECT_GT(testing::parallel_splits(), splits) << what << ": no pass ran on several threads";
+      testing::set_parallel_grain(0);
+    }
+    set_thread_count(0);
+  }
 }
 
 TEST(Mesh, HeapBytesCountsArrays) {
