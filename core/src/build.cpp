@@ -1335,34 +1335,67 @@ Soup extract(const Mesh& mesh, const ExtractOptions& options, ExtractReport* rep
     for (std::size_t i = 0; i < n_out_vertices; ++i) soup.positions[i] = mesh.positions()[order[i]];
   }
 
-  // Faces and corners; corner_halfedge remembers where each corner's data lives.
+  // Faces and corners; corner_halfedge remembers where each corner's data lives. Two passes
+  // over ranges of faces, on several threads: count each range's faces and corners, then
+  // write each range at its place in the output (the live faces in index order).
   const std::size_t nfs = mesh.faces_size();
   const bool faces_identity = mesh.n_faces() == nfs;
-  soup.face_sizes.reserve(mesh.n_faces());
-  std::size_t n_inner = 0;
-  for (Halfedge h : mesh.halfedges())
-    if (!mesh.is_boundary(h)) ++n_inner;
-  soup.corners.reserve(n_inner);
   bool has_corner_channels = false;
   const PropertyContainer& hprops = mesh.halfedge_properties();
   for (std::size_t i = 0; i < hprops.count(); ++i) has_corner_channels |= hprops.at(i).type() == typeid(ChannelArray);
-  std::vector<std::uint32_t> corner_halfedge;
-  if (has_corner_channels) corner_halfedge.reserve(n_inner);
-  std::vector<Halfedge> loop;
-  for (Face f : mesh.faces()) {
-    loop.clear();
-    for (Halfedge h : mesh.halfedges(f)) loop.push_back(h);
-    // Undo build()'s flip: c0, cn-1, ..., c1 is its own inverse.
-    if (flipped && flipped->vector()[f.idx()]) std::reverse(loop.begin() + 1, loop.end());
-    soup.face_sizes.push_back(static_cast<std::uint32_t>(loop.size()));
-    for (Halfedge h : loop) {
-      const std::uint32_t v = mesh.to_vertex(h).idx();
-      soup.corners.push_back(vertices_identity ? v : vmap[v]);
-      if (has_corner_channels) corner_halfedge.push_back(h.idx());
-    }
+  struct FaceRange {
+    std::size_t begin = 0, end = 0;  // mesh faces
+    std::size_t faces = 0, corners = 0;
+  };
+  std::vector<FaceRange> ranges = parallel_parts<FaceRange>(nfs, 0, [&](std::size_t b, std::size_t e, FaceRange& r) {
+    r.begin = b, r.end = e;
+    for (std::size_t f = b; f < e; ++f)
+      if (!mesh.is_deleted(Face(static_cast<Index>(f)))) {
+        ++r.faces;
+        r.corners += mesh.valence(Face(static_cast<Index>(f)));
+      }
+  });
+  std::size_t n_faces = 0, n_corners = 0;
+  for (FaceRange& r : ranges) {
+    const std::size_t faces = r.faces, corners = r.corners;
+    r.faces = n_faces, r.corners = n_corners;  // from here on: where the range's output starts
+    n_faces += faces, n_corners += corners;
   }
+  soup.face_sizes.resize(n_faces);
+  soup.corners.resize(n_corners);
+  std::vector<std::uint32_t> corner_halfedge(has_corner_channels ? n_corners : 0);
+  parallel_for(
+      ranges.size(), 0,
+      [&](std::size_t first_range, std::size_t last_range) {
+        std::vector<Halfedge> loop;
+        for (std::size_t r = first_range; r < last_range; ++r) {
+          std::size_t k = ranges[r].faces, c = ranges[r].corners;
+          for (std::size_t i = ranges[r].begin; i < ranges[r].end; ++i) {
+            const Face f(static_cast<Index>(i));
+            if (mesh.is_deleted(f)) continue;
+            loop.clear();
+            for (Halfedge h : mesh.halfedges(f)) loop.push_back(h);
+            // Undo build()'s flip: c0, cn-1, ..., c1 is its own inverse.
+            if (flipped && flipped->vector()[f.idx()]) std::reverse(loop.begin() + 1, loop.end());
+            soup.face_sizes[k++] = static_cast<std::uint32_t>(loop.size());
+            for (Halfedge h : loop) {
+              const std::uint32_t v = mesh.to_vertex(h).idx();
+              if (has_corner_channels) corner_halfedge[c] = h.idx();
+              soup.corners[c++] = vertices_identity ? v : vmap[v];
+            }
+          }
+        }
+      },
+      1);
 
   // Attributes: every ChannelArray; TypedArrays are the mesh's own and stay inside.
+  // gather(c, n, at): element k of c's data is copied from at(k), on several threads.
+  auto gather = [](Channel& c, std::size_t n, auto&& at) {
+    const std::size_t stride = c.stride();
+    parallel_for(n, 0, [&](std::size_t b, std::size_t e) {
+      for (std::size_t k = b; k < e; ++k) std::memcpy(c.data.data() + k * stride, at(k), stride);
+    });
+  };
   auto emit = [&](const PropertyContainer& props, Domain domain) {
     for (std::size_t i = 0; i < props.count(); ++i) {
       const PropertyArray& array = props.at(i);
@@ -1380,8 +1413,7 @@ Soup extract(const Mesh& mesh, const ExtractOptions& options, ExtractReport* rep
           if (vertices_identity) {
             if (nvs) std::memcpy(c.data.data(), a.element(0), nvs * stride);
           } else {
-            for (std::size_t k = 0; k < n_out_vertices; ++k)
-              std::memcpy(c.data.data() + k * stride, a.element(mesh_vertex(k)), stride);
+            gather(c, n_out_vertices, [&](std::size_t k) { return a.element(mesh_vertex(k)); });
           }
           break;
         case Domain::face: {
@@ -1396,8 +1428,7 @@ Soup extract(const Mesh& mesh, const ExtractOptions& options, ExtractReport* rep
         }
         case Domain::corner:
           c.data.resize(corner_halfedge.size() * stride);
-          for (std::size_t k = 0; k < corner_halfedge.size(); ++k)
-            std::memcpy(c.data.data() + k * stride, a.element(corner_halfedge[k]), stride);
+          gather(c, corner_halfedge.size(), [&](std::size_t k) { return a.element(corner_halfedge[k]); });
           break;
       }
       soup.channels.push_back(std::move(c));
