@@ -22,6 +22,7 @@ namespace {
 struct Part {
   std::optional<std::pair<Index, std::string>> failure;
   std::vector<Index> seen;  // faces(): the face that last visited each vertex
+  std::size_t count = 0;    // live half-edges seen (halfedge()), or held by fans (fan())
 
   template <class... Args>
   bool fail(Index at, Args&&... args) {
@@ -38,10 +39,20 @@ class Checker {
 
   Validation run() {
     if (!sizes()) return result_;
-    if (!each(m_.halfedges_size(), [this](Index i, Part& p) { return halfedge(i, p); })) return result_;
+    std::size_t live = 0, in_fans = 0;
+    auto halfedges = [this](Index i, Part& p) { return halfedge(i, p); };
+    if (!each(m_.halfedges_size(), halfedges, &live)) return result_;
     if (!each(m_.faces_size(), [this](Index i, Part& p) { return face(i, p); })) return result_;
-    count_outgoing();
-    each(m_.vertices_size(), [this](Index i, Part& p) { return vertex(i, p); });
+    // Every vertex's fan closes and leaves only it, so the fans are apart: when they hold every
+    // live half-edge, no vertex is non-manifold. Otherwise the vertices are checked again with
+    // each one's count of outgoing half-edges, which names the first one that breaks.
+    auto vertices = [this](const std::vector<Index>* outgoing, std::size_t* held) {
+      return each(
+          m_.vertices_size(), [&](Index i, Part& p) { return vertex(i, p, outgoing); }, held);
+    };
+    if (vertices(nullptr, &in_fans) && in_fans == live) return result_;
+    result_ = {};
+    vertices(&count_outgoing(), nullptr);
     return result_;
   }
 
@@ -53,18 +64,21 @@ class Checker {
 
   // check(i, part) for every i in [0, n), parts of the range on several threads; true when
   // every check passes, else false with the message of the failure at the lowest index.
+  // `total`: the parts' counts added up.
   template <class Check>
-  bool each(std::size_t n, Check&& check) {
+  bool each(std::size_t n, Check&& check, std::size_t* total = nullptr) {
     std::mutex mutex;
     std::optional<std::pair<Index, std::string>> first;
+    std::size_t sum = 0;
     parallel_for(n, 0, [&](std::size_t begin, std::size_t end) {
       Part part;
       for (std::size_t i = begin; i < end; ++i)
         if (!check(static_cast<Index>(i), part)) break;
-      if (!part.failure) return;
       std::lock_guard lock(mutex);
-      if (!first || part.failure->first < first->first) first = std::move(part.failure);
+      sum += part.count;
+      if (part.failure && (!first || part.failure->first < first->first)) first = std::move(part.failure);
     });
+    if (total) *total = sum;
     return first ? fail(std::move(first->second)) : true;
   }
 
@@ -85,6 +99,7 @@ class Checker {
   bool halfedge(Index i, Part& part) const {
     Halfedge h(i);
     if (m_.is_deleted(h)) return true;
+    ++part.count;
     Halfedge n = m_.next(h), p = m_.prev(h);
     Vertex v = m_.to_vertex(h);
     Face f = m_.face(h);
@@ -128,7 +143,7 @@ class Checker {
 
   // How many live half-edges leave each vertex, counted on several threads (atomically only
   // when the count is split).
-  void count_outgoing() {
+  const std::vector<Index>& count_outgoing() {
     const std::size_t n = m_.halfedges_size();
     outgoing_.assign(m_.vertices_size(), 0);
     parallel_for(n, 0, [this, n](std::size_t begin, std::size_t end) {
@@ -143,19 +158,22 @@ class Checker {
           std::atomic_ref(count).fetch_add(1, std::memory_order_relaxed);
       }
     });
+    return outgoing_;
   }
 
-  // Every vertex must be manifold: rotating around it reaches all its outgoing half-edges.
-  bool vertex(Index i, Part& part) const {
+  // Every vertex must be manifold: its fan closes, every half-edge in it leaves the vertex, at
+  // most one gap. The fan's size goes to part.count; given `outgoing` (each vertex's count of
+  // live half-edges leaving it), the fan must also hold all of them.
+  bool vertex(Index i, Part& part, const std::vector<Index>* outgoing) const {
     Vertex v(i);
-    const Index outgoing = outgoing_[i];
+    const Index leaving = outgoing ? (*outgoing)[i] : 0;
     if (m_.is_deleted(v)) {
-      if (outgoing) return part.fail(i, "vertex ", i, ": deleted but still has ", outgoing, " edges");
+      if (leaving) return part.fail(i, "vertex ", i, ": deleted but still has ", leaving, " edges");
       return true;
     }
     Halfedge start = m_.halfedge(v);
     if (!start.is_valid()) {
-      if (outgoing) return part.fail(i, "vertex ", i, ": has no half-edge but ", outgoing, " edges");
+      if (leaving) return part.fail(i, "vertex ", i, ": has no half-edge but ", leaving, " edges");
       return true;
     }
     if (!in_range(start) || m_.is_deleted(start))
@@ -170,11 +188,12 @@ class Checker {
       h = m_.ccw_rotated(h);
       if (++n > bound) return part.fail(i, "vertex ", i, ": rotation does not close");
     } while (h != start);
-    if (n != outgoing)
-      return part.fail(i, "vertex ", i, ": non-manifold, its fan holds ", n, " of its ", outgoing, " edges");
+    if (outgoing && n != leaving)
+      return part.fail(i, "vertex ", i, ": non-manifold, its fan holds ", n, " of its ", leaving, " edges");
     if (boundary > 1) return part.fail(i, "vertex ", i, ": non-manifold, ", boundary, " boundary gaps");
     if (boundary == 1 && !m_.is_boundary(start))
       return part.fail(i, "vertex ", i, ": on the boundary but halfedge(v) is not its boundary half-edge");
+    part.count += n;
     return true;
   }
 

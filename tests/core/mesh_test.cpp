@@ -422,6 +422,34 @@ TEST(Mesh, ValidateNamesTheFirstBreakOnAnyThreadCount) {
   }
 }
 
+// Two closed fans at one vertex (two tetrahedra glued at a corner): each fan closes, so only
+// counting the half-edges that leave the vertex tells that its rotation misses half of them.
+TEST(Mesh, ValidateFindsAVertexWithTwoClosedFans) {
+  const std::vector<Point> corners = {{{0, 0, 0}}, {{1, 0, 0}}, {{0, 1, 0}}, {{0, 0, 1}}};
+  std::vector<Point> points = corners;
+  for (const Point& p : corners) points.push_back(Point{{p[0] + 3, p[1], p[2]}});
+  const std::vector<std::vector<Index>> tetrahedron = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+  std::vector<std::vector<Index>> faces = tetrahedron;
+  for (auto f : tetrahedron) {
+    for (Index& v : f) v += 4;
+    faces.push_back(f);
+  }
+  Mesh m = test::make_mesh(points, faces);
+  ASSERT_TRUE(validate(m)) << validate(m).message;
+  for (Halfedge h : m.halfedges())
+    if (m.to_vertex(h) == Vertex(4)) m.set_vertex(h, Vertex(0));
+  m.set_halfedge(Vertex(4), Halfedge());  // left isolated
+  const std::string expected = "vertex 0: non-manifold, its fan holds 3 of its 6 edges";
+  EXPECT_EQ(validate(m).message, expected);
+  for (unsigned threads : {2u, 3u}) {
+    set_thread_count(threads);
+    testing::set_parallel_grain(1);
+    EXPECT_EQ(validate(m).message, expected) << threads << " threads";
+    testing::set_parallel_grain(0);
+  }
+  set_thread_count(0);
+}
+
 TEST(Mesh, HeapBytesCountsArrays) {
   Mesh m = quad_grid();
   m.shrink_to_fit();
