@@ -206,10 +206,9 @@ class SoupBuffers {
     soup_.corners.resize(corners);
   }
   // The soup the mesh dict describes, refused while an operation reads these buffers.
-  const Soup& read(const py::dict& mesh) {
+  void read(const py::dict& mesh) {
     if (readers_.load() > 0) throw Error("the mesh's buffers are in use by a running operation");
     read_soup(mesh, soup_, &spare_);
-    return soup_;
   }
   const Soup& soup() const { return soup_; }
   Soup& soup() { return soup_; }

@@ -1343,20 +1343,21 @@ Soup extract(const Mesh& mesh, const ExtractOptions& options, ExtractReport* rep
   bool has_corner_channels = false;
   const PropertyContainer& hprops = mesh.halfedge_properties();
   for (std::size_t i = 0; i < hprops.count(); ++i) has_corner_channels |= hprops.at(i).type() == typeid(ChannelArray);
-  struct FaceRange {
+  struct OutputRange {
     std::size_t begin = 0, end = 0;  // mesh faces
     std::size_t faces = 0, corners = 0;
   };
-  std::vector<FaceRange> ranges = parallel_parts<FaceRange>(nfs, 0, [&](std::size_t b, std::size_t e, FaceRange& r) {
-    r.begin = b, r.end = e;
-    for (std::size_t f = b; f < e; ++f)
-      if (!mesh.is_deleted(Face(static_cast<Index>(f)))) {
-        ++r.faces;
-        r.corners += mesh.valence(Face(static_cast<Index>(f)));
-      }
-  });
+  std::vector<OutputRange> ranges =
+      parallel_parts<OutputRange>(nfs, 0, [&](std::size_t b, std::size_t e, OutputRange& r) {
+        r.begin = b, r.end = e;
+        for (std::size_t f = b; f < e; ++f)
+          if (!mesh.is_deleted(Face(static_cast<Index>(f)))) {
+            ++r.faces;
+            r.corners += mesh.valence(Face(static_cast<Index>(f)));
+          }
+      });
   std::size_t n_faces = 0, n_corners = 0;
-  for (FaceRange& r : ranges) {
+  for (OutputRange& r : ranges) {
     const std::size_t faces = r.faces, corners = r.corners;
     r.faces = n_faces, r.corners = n_corners;  // from here on: where the range's output starts
     n_faces += faces, n_corners += corners;

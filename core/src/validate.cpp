@@ -21,8 +21,8 @@ namespace {
 // What one part of a pass found: its first failure, and the scratch its checks share.
 struct Part {
   std::optional<std::pair<Index, std::string>> failure;
-  std::vector<Index> seen;  // faces(): the face that last visited each vertex
-  std::size_t count = 0;    // live half-edges seen (halfedge()), or held by fans (fan())
+  std::vector<Index> seen;  // face(): the face that last visited each vertex
+  std::size_t count = 0;    // live half-edges seen (halfedge()), or held by fans (vertex())
 
   template <class... Args>
   bool fail(Index at, Args&&... args) {
@@ -52,7 +52,8 @@ class Checker {
     };
     if (vertices(nullptr, &in_fans) && in_fans == live) return result_;
     result_ = {};
-    vertices(&count_outgoing(), nullptr);
+    const std::vector<Index> outgoing = count_outgoing();
+    vertices(&outgoing, nullptr);
     return result_;
   }
 
@@ -143,22 +144,22 @@ class Checker {
 
   // How many live half-edges leave each vertex, counted on several threads (atomically only
   // when the count is split).
-  const std::vector<Index>& count_outgoing() {
+  std::vector<Index> count_outgoing() const {
     const std::size_t n = m_.halfedges_size();
-    outgoing_.assign(m_.vertices_size(), 0);
-    parallel_for(n, 0, [this, n](std::size_t begin, std::size_t end) {
+    std::vector<Index> outgoing(m_.vertices_size(), 0);
+    parallel_for(n, 0, [&](std::size_t begin, std::size_t end) {
       const bool alone = begin == 0 && end == n;
       for (std::size_t i = begin; i < end; ++i) {
         const Halfedge h(static_cast<Index>(i));
         if (m_.is_deleted(h)) continue;
-        Index& count = outgoing_[m_.from_vertex(h).idx()];
+        Index& count = outgoing[m_.from_vertex(h).idx()];
         if (alone)
           ++count;
         else
           std::atomic_ref(count).fetch_add(1, std::memory_order_relaxed);
       }
     });
-    return outgoing_;
+    return outgoing;
   }
 
   // Every vertex must be manifold: its fan closes, every half-edge in it leaves the vertex, at
@@ -198,7 +199,6 @@ class Checker {
   }
 
   const Mesh& m_;
-  std::vector<Index> outgoing_;
   Validation result_;
 };
 

@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -281,10 +282,12 @@ class DefectRule {
       std::fprintf(stderr, "[rule] %s: %s (allowed %zu/%zu/%zu/%zu, %zu copies kept apart)\n", what.c_str(),
                    hedge_fuzz::describe(out).c_str(), allowed_[0], allowed_[1], allowed_[2], allowed_[3],
                    report.copies_kept_apart);
+    std::optional<EditMade> made;
     for (int k = 0; k < 4; ++k) {
       if (out.at(k) <= allowed_[k]) continue;
       // Only then: what the edits made in the mesh itself (counting it costs as much again).
-      const std::size_t edits = EditMade::of(mesh).minus(since_).allows(k);
+      if (!made) made = EditMade::of(mesh).minus(since_);
+      const std::size_t edits = made->allows(k);
       if (out.at(k) <= allowed_[k] + edits) continue;
       if (trace_) {
         hedge::ExtractOptions own;
