@@ -1,5 +1,7 @@
 // Wavefront OBJ files: positions (with optional vertex colours), per-corner texture
 // coordinates and normals, polygons with absolute or relative indices, usemtl as a material id.
+#include <algorithm>
+#include <array>
 #include <cstdint>
 #include <cstring>
 #include <string>
@@ -215,31 +217,56 @@ class ObjReader {
   bool seen_material_ = false;
 };
 
-struct BitsHash {
-  std::size_t operator()(const std::array<std::uint32_t, 3>& k) const {
+//! Numbers values by first use, equal bit patterns sharing a number, so each distinct
+//! uv or normal is written once. Open addressing over a flat table: a map of nodes spent
+//! more time allocating than hashing.
+template <int N>
+class Dedup {
+ public:
+  std::uint32_t add(const float* v) {
+    Key key{};
+    std::memcpy(key.data(), v, N * sizeof(float));
+    if (2 * (count() + 1) > slots_.size()) grow();
+    const std::size_t mask = slots_.size() - 1;
+    for (std::size_t i = hash(key) & mask;; i = (i + 1) & mask) {
+      Slot& slot = slots_[i];
+      if (slot.id == kEmpty) {
+        slot = {key, count()};
+        values_.insert(values_.end(), v, v + N);
+        return slot.id;
+      }
+      if (slot.key[0] == key[0] && slot.key[1] == key[1] && slot.key[2] == key[2]) return slot.id;  // no memcmp call
+    }
+  }
+  const std::vector<float>& values() const { return values_; }
+
+ private:
+  using Key = std::array<std::uint32_t, 3>;
+  static constexpr std::uint32_t kEmpty = 0xffffffffu;
+  struct Slot {
+    Key key{};
+    std::uint32_t id = kEmpty;
+  };
+  static std::size_t hash(const Key& k) {
     std::uint64_t h = (static_cast<std::uint64_t>(k[0]) << 32 | k[1]) * 0x9e3779b97f4a7c15ull ^ k[2];
     h ^= h >> 29;
     h *= 0xbf58476d1ce4e5b9ull;
     return static_cast<std::size_t>(h ^ (h >> 32));
   }
-};
-
-//! Numbers values by first use, equal bit patterns sharing a number, so each distinct
-//! uv or normal is written once.
-template <int N>
-class Dedup {
- public:
-  std::uint32_t add(const float* v) {
-    std::array<std::uint32_t, 3> key{};
-    std::memcpy(key.data(), v, N * sizeof(float));
-    auto [it, added] = ids_.try_emplace(key, static_cast<std::uint32_t>(values_.size() / N));
-    if (added) values_.insert(values_.end(), v, v + N);
-    return it->second;
+  std::uint32_t count() const { return static_cast<std::uint32_t>(values_.size() / N); }
+  void grow() {
+    std::vector<Slot> old(std::max<std::size_t>(1024, 2 * slots_.size()));
+    old.swap(slots_);
+    const std::size_t mask = slots_.size() - 1;
+    for (const Slot& slot : old)
+      if (slot.id != kEmpty) {
+        std::size_t i = hash(slot.key) & mask;
+        while (slots_[i].id != kEmpty) i = (i + 1) & mask;
+        slots_[i] = slot;
+      }
   }
-  const std::vector<float>& values() const { return values_; }
 
- private:
-  std::unordered_map<std::array<std::uint32_t, 3>, std::uint32_t, BitsHash> ids_;
+  std::vector<Slot> slots_;
   std::vector<float> values_;
 };
 
@@ -280,68 +307,65 @@ std::string write_obj(const Soup& soup) {
   if (color && !(color->components == 4 && (color->scalar == ScalarType::f32 || color->scalar == ScalarType::u8)))
     color = nullptr;
 
-  std::string out;
-  out.reserve(soup.n_vertices() * 32 + nc * 12 + uvs.values().size() * 12 + normals.values().size() * 12);
-  out += "# written by hedge\n";
-  for (std::size_t v = 0; v < soup.n_vertices(); ++v) {
-    out += 'v';
+  std::string out = "# written by hedge\n";
+  append_elements(out, soup.n_vertices(), [&](std::string& text, std::size_t v) {
+    text += 'v';
     for (int k = 0; k < 3; ++k) {
-      out += ' ';
-      append_number(out, soup.positions[v][k]);
+      text += ' ';
+      append_number(text, soup.positions[v][k]);
     }
     if (color) {
       // OBJ has no alpha: it is dropped.
       for (int k = 0; k < 3; ++k) {
-        out += ' ';
+        text += ' ';
         if (color->scalar == ScalarType::f32)
-          append_number(out, color->as<float>()[4 * v + k]);
+          append_number(text, color->as<float>()[4 * v + k]);
         else
-          append_number(out, static_cast<float>(color->as<std::uint8_t>()[4 * v + k]) / 255.0f);
+          append_number(text, static_cast<float>(color->as<std::uint8_t>()[4 * v + k]) / 255.0f);
       }
     }
-    out += '\n';
-  }
-  for (std::size_t i = 0; i < uvs.values().size(); i += 2) {
-    out += "vt ";
-    append_number(out, uvs.values()[i]);
-    out += ' ';
-    append_number(out, uvs.values()[i + 1]);
-    out += '\n';
-  }
-  for (std::size_t i = 0; i < normals.values().size(); i += 3) {
-    out += "vn";
+    text += '\n';
+  });
+  append_elements(out, uvs.values().size() / 2, [&](std::string& text, std::size_t i) {
+    text += "vt ";
+    append_number(text, uvs.values()[2 * i]);
+    text += ' ';
+    append_number(text, uvs.values()[2 * i + 1]);
+    text += '\n';
+  });
+  append_elements(out, normals.values().size() / 3, [&](std::string& text, std::size_t i) {
+    text += "vn";
     for (int k = 0; k < 3; ++k) {
-      out += ' ';
-      append_number(out, normals.values()[i + k]);
+      text += ' ';
+      append_number(text, normals.values()[3 * i + k]);
     }
-    out += '\n';
-  }
-  std::int32_t current_material = -1;
-  for (std::size_t f = 0; f < soup.n_faces(); ++f) {
+    text += '\n';
+  });
+  append_elements(out, soup.n_faces(), [&](std::string& text, std::size_t f) {
     if (material) {
-      std::int32_t m = material->as<std::int32_t>()[f];
-      if (m != current_material) {
-        out += "usemtl ";
-        out += m >= 0 ? "material_" + std::to_string(m) : std::string("default");
-        out += '\n';
-        current_material = m;
+      // A face opens a new material group where its material differs from the face before.
+      const std::int32_t m = material->as<std::int32_t>()[f];
+      if (m != (f == 0 ? -1 : material->as<std::int32_t>()[f - 1])) {
+        text += "usemtl ";
+        text += m >= 0 ? "material_" + std::to_string(m) : std::string("default");
+        text += '\n';
       }
     }
-    out += 'f';
+    text += 'f';
     for (std::size_t c = offsets[f]; c < offsets[f + 1]; ++c) {
-      out += ' ';
-      append_number(out, soup.corners[c] + std::uint64_t{1});
+      text += ' ';
+      append_number(text, soup.corners[c] + std::uint64_t{1});
       if (!vt.empty() || !vn.empty()) {
-        out += '/';
-        if (!vt.empty()) append_number(out, vt[c] + std::uint64_t{1});
+        text += '/';
+        if (!vt.empty()) append_number(text, vt[c] + std::uint64_t{1});
         if (!vn.empty()) {
-          out += '/';
-          append_number(out, vn[c] + std::uint64_t{1});
+          text += '/';
+          append_number(text, vn[c] + std::uint64_t{1});
         }
       }
     }
-    out += '\n';
-  }
+    text += '\n';
+  });
   return out;
 }
 

@@ -240,7 +240,6 @@ std::string write_off(const Soup& soup) {
   ColorView face_colors = find_color(soup, Domain::face);
 
   std::string out;
-  out.reserve(soup.n_vertices() * 30 + soup.n_corners() * 8);
   if (uvs) out += "ST";
   if (colors) out += "C";
   if (normals) out += "N";
@@ -249,34 +248,34 @@ std::string write_off(const Soup& soup) {
   out += ' ';
   append_number(out, soup.n_faces());
   out += " 0\n";
-  for (std::size_t v = 0; v < soup.n_vertices(); ++v) {
+  append_elements(out, soup.n_vertices(), [&](std::string& text, std::size_t v) {
     for (int k = 0; k < 3; ++k) {
-      if (k) out += ' ';
-      append_number(out, soup.positions[v][k]);
+      if (k) text += ' ';
+      append_number(text, soup.positions[v][k]);
     }
     if (normals)
       for (int k = 0; k < 3; ++k) {
-        out += ' ';
-        append_number(out, normals->as<float>()[3 * v + k]);
+        text += ' ';
+        append_number(text, normals->as<float>()[3 * v + k]);
       }
-    if (colors) append_color(out, colors[v]);
+    if (colors) append_color(text, colors[v]);
     if (uvs)
       for (int k = 0; k < 2; ++k) {
-        out += ' ';
-        append_number(out, uvs->as<float>()[2 * v + k]);
+        text += ' ';
+        append_number(text, uvs->as<float>()[2 * v + k]);
       }
-    out += '\n';
-  }
-  std::size_t corner = 0;
-  for (std::size_t f = 0; f < soup.n_faces(); ++f) {
-    append_number(out, soup.face_sizes[f]);
-    for (std::uint32_t k = 0; k < soup.face_sizes[f]; ++k) {
-      out += ' ';
-      append_number(out, soup.corners[corner++]);
+    text += '\n';
+  });
+  const std::vector<std::size_t> offsets = soup.face_offsets();
+  append_elements(out, soup.n_faces(), [&](std::string& text, std::size_t f) {
+    append_number(text, soup.face_sizes[f]);
+    for (std::size_t c = offsets[f]; c < offsets[f + 1]; ++c) {
+      text += ' ';
+      append_number(text, soup.corners[c]);
     }
-    if (face_colors) append_color(out, face_colors[f]);
-    out += '\n';
-  }
+    if (face_colors) append_color(text, face_colors[f]);
+    text += '\n';
+  });
   return out;
 }
 

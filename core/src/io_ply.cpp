@@ -711,11 +711,8 @@ std::string write_ply(const Soup& soup, bool binary) {
   if (material) out += "property int material_index\n";
   if (face_selected) out += "property uchar selected\n";
   out += "end_header\n";
-  out.reserve(out.size() + soup.n_vertices() * (binary ? 12 : 30) + soup.n_corners() * (binary ? 4 : 8) +
-              soup.n_faces() * 2);
-
-  Writer w(out, binary);
-  for (std::size_t v = 0; v < soup.n_vertices(); ++v) {
+  append_elements(out, soup.n_vertices(), [&](std::string& text, std::size_t v) {
+    Writer w(text, binary);
     for (int k = 0; k < 3; ++k) w.value(soup.positions[v][k]);
     if (normals)
       for (int k = 0; k < 3; ++k) w.value(normals->as<float>()[3 * v + k]);
@@ -726,9 +723,11 @@ std::string write_ply(const Soup& soup, bool binary) {
       for (int k = 0; k < 2; ++k) w.value(uvs->as<float>()[2 * v + k]);
     if (selected) w.value(selected->as<std::uint8_t>()[v]);
     w.end_element();
-  }
-  std::size_t corner = 0;
-  for (std::size_t f = 0; f < soup.n_faces(); ++f) {
+  });
+  const std::vector<std::size_t> offsets = soup.face_offsets();
+  append_elements(out, soup.n_faces(), [&](std::string& text, std::size_t f) {
+    Writer w(text, binary);
+    const std::size_t corner = offsets[f];
     const std::uint32_t size = soup.face_sizes[f];
     if (small_faces)
       w.value(static_cast<std::uint8_t>(size));
@@ -753,8 +752,7 @@ std::string write_ply(const Soup& soup, bool binary) {
     if (material) w.value(material->as<std::int32_t>()[f]);
     if (face_selected) w.value(face_selected->as<std::uint8_t>()[f]);
     w.end_element();
-    corner += size;
-  }
+  });
   return out;
 }
 

@@ -210,46 +210,45 @@ std::string write_stl(const Soup& soup, bool binary) {
     out.reserve(triangles * 250);
     out += "solid hedge\n";
   }
-  auto vertex = [&](const Point& p) {
-    if (binary) {
-      for (int k = 0; k < 3; ++k) append_le(out, p[k]);
-    } else {
-      out += "      vertex";
-      for (int k = 0; k < 3; ++k) {
-        out += ' ';
-        append_number(out, p[k]);
+  const std::vector<std::size_t> offsets = soup.face_offsets();
+  append_elements(out, soup.n_faces(), [&](std::string& text, std::size_t f) {
+    auto vertex = [&](const Point& p) {
+      if (binary) {
+        for (int k = 0; k < 3; ++k) append_le(text, p[k]);
+      } else {
+        text += "      vertex";
+        for (int k = 0; k < 3; ++k) {
+          text += ' ';
+          append_number(text, p[k]);
+        }
+        text += '\n';
       }
-      out += '\n';
-    }
-  };
-  std::size_t corner = 0;
-  for (std::uint32_t size : soup.face_sizes) {
-    const std::uint32_t* c = soup.corners.data() + corner;
-    corner += size;
-    for (std::uint32_t k = 1; k + 1 < size; ++k) {
+    };
+    const std::uint32_t* c = soup.corners.data() + offsets[f];
+    for (std::uint32_t k = 1; k + 1 < soup.face_sizes[f]; ++k) {
       const Point& a = soup.positions[c[0]];
       const Point& b = soup.positions[c[k]];
       const Point& d = soup.positions[c[k + 1]];
       Vec3f n = to_float(normalize(cross(to_double(b) - to_double(a), to_double(d) - to_double(a))));
       if (binary) {
-        for (int i = 0; i < 3; ++i) append_le(out, n[i]);
+        for (int i = 0; i < 3; ++i) append_le(text, n[i]);
       } else {
-        out += "  facet normal";
+        text += "  facet normal";
         for (int i = 0; i < 3; ++i) {
-          out += ' ';
-          append_number(out, n[i]);
+          text += ' ';
+          append_number(text, n[i]);
         }
-        out += "\n    outer loop\n";
+        text += "\n    outer loop\n";
       }
       vertex(a);
       vertex(b);
       vertex(d);
       if (binary)
-        append_le(out, std::uint16_t{0});
+        append_le(text, std::uint16_t{0});
       else
-        out += "    endloop\n  endfacet\n";
+        text += "    endloop\n  endfacet\n";
     }
-  }
+  });
   if (!binary) out += "endsolid hedge\n";
   return out;
 }

@@ -26,6 +26,8 @@
 
 #include "hedge/error.h"
 #include "hedge/soup.h"
+#include "hedge/threads.h"
+#include "parallel.h"
 
 namespace hedge {
 namespace {
@@ -951,6 +953,44 @@ TEST(IoRealMeshes, DragonRes4) {
     for (std::size_t c = 0; c < s.n_corners(); ++c) ASSERT_EQ(t.positions[t.corners[c]], s.positions[s.corners[c]]);
   }
   expect_same(read_obj(write_obj(s), "d.obj"), s);
+}
+
+TEST(IoRealMeshes, WritersGiveTheSameBytesInRunsOnAnyThreadCount) {
+  // Writers format runs of elements on several threads: the dragon (coarse) with every
+  // channel a writer carries, in one run and in runs of 7 elements on 1 to 8 threads.
+  std::string path = mesh_path("dragon_res4.ply");
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " is absent";
+  Soup s = read_mesh(path);
+  const std::size_t nv = s.n_vertices(), nc = s.n_corners(), nf = s.n_faces();
+  std::vector<float> uv(2 * nc), normal(3 * nv), color(4 * nv);
+  std::vector<std::int32_t> material(nf);
+  for (std::size_t i = 0; i < uv.size(); ++i) uv[i] = s.positions[s.corners[i / 2]][i % 2];
+  for (std::size_t i = 0; i < normal.size(); ++i) normal[i] = s.positions[i / 3][i % 3] * 0.5f;
+  for (std::size_t i = 0; i < color.size(); ++i) color[i] = float(i % 255) / 255.0f;
+  for (std::size_t f = 0; f < nf; ++f) material[f] = std::int32_t(f / 100 % 3) - 1;
+  s.channels.push_back(make_channel("uv", Domain::corner, ScalarType::f32, 2, uv));
+  s.channels.push_back(make_channel("normal", Domain::vertex, ScalarType::f32, 3, normal));
+  s.channels.push_back(make_channel("color", Domain::vertex, ScalarType::f32, 4, color));
+  s.channels.push_back(make_channel("material", Domain::face, ScalarType::i32, 1, material));
+  ASSERT_NO_THROW(s.check());
+  auto write_all = [&] {
+    return std::vector<std::string>{write_off(s),       write_obj(s),        write_ply(s, false),
+                                    write_ply(s, true), write_stl(s, false), write_stl(s, true)};
+  };
+  const std::vector<std::string> whole = write_all();
+  for (unsigned threads : {1u, 2u, 3u, 8u}) {
+    set_thread_count(threads);
+    testing::set_parallel_grain(7);
+    const std::size_t splits = testing::parallel_splits();
+    const std::vector<std::string> in_runs = write_all();
+    if (threads > 1) {
+      EXPECT_GT(testing::parallel_splits(), splits);
+    }
+    set_thread_count(0);
+    testing::set_parallel_grain(0);
+    for (std::size_t i = 0; i < whole.size(); ++i)
+      EXPECT_TRUE(in_runs[i] == whole[i]) << "writer " << i << ", " << threads << " threads";
+  }
 }
 
 TEST(IoRealMeshes, Dragon) {
