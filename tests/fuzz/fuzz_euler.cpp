@@ -6,6 +6,8 @@
 #include <fuzzer/FuzzedDataProvider.h>
 
 #include <algorithm>
+#include <array>
+#include <bit>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -149,9 +151,11 @@ void validated(const Mesh& mesh, const std::string& after) {
 //! starts as the first soup's own counts. A catalogue operation runs as a host runs it
 //! (run_operation()): on a mesh built afresh from the soup the host holds by then, which
 //! becomes the soup to compare with; subdivision may multiply the counts by its own rule,
-//! step by step. Euler operations are edits, not operations: the duplicate faces they make in
-//! the mesh itself (extracted without welding; the one defect a valid mesh can hold, such as
-//! a hole of three edges filled next to a triangle) are allowed on top, and so are the defects
+//! step by step. Euler operations are edits, not operations: the faces they make over the
+//! vertex set of another once copies are welded (no weld avoids those duplicates; in the mesh
+//! itself, such as a hole of three edges filled next to a triangle, or across copies, such as
+//! a flip whose triangle covers a quad visiting one vertex twice), counted per vertex set, are
+//! allowed on top, and so are the defects
 //! of a face an edit spans over two copies of one host vertex: welded back, it would visit that
 //! vertex twice, so extract() keeps copies apart, and whichever it keeps, the face shares its
 //! edges with the copies' own faces (a repeated vertex, or non-manifold edges and vertices around
@@ -191,7 +195,7 @@ class DefectRule {
     if (!off_) {
       if (!edits_.empty() && !every_) check(mesh, edits_);
       edits_.clear();
-      const EditMade made = EditMade::of(mesh).minus(since_);
+      const EditMade::Gained made = EditMade::of(mesh).minus(since_);
       for (int k = 0; k < 4; ++k) allowed_[k] += made.allows(k);
     }
     if (!host_fresh_) {
@@ -230,43 +234,59 @@ class DefectRule {
     return value ? value : "";
   }
   //! What Euler edits make in the mesh itself that extract() cannot weld without a defect:
-  //! faces over the vertex set of another (no weld), and faces over two copies of one host
-  //! vertex, with their corners.
+  //! faces over the vertex set of another once copies are welded (no weld avoids the
+  //! duplicate), and faces over two copies of one host vertex, with their corners.
   struct EditMade {
-    std::size_t duplicates = 0, self_welding = 0, self_welding_corners = 0;
+    //! A vertex as the weld sees it: its host vertex, or, for a vertex an edit or an
+    //! operation made, its place (what stays the same through garbage collection).
+    using Key = std::array<std::uint32_t, 4>;
+    //! Faces by their welded vertex sets, with how many share each set.
+    std::map<std::vector<Key>, std::size_t> sets;
+    std::size_t self_welding = 0, self_welding_corners = 0;
 
     static EditMade of(const Mesh& mesh) {
       const auto* source = mesh.vertex_properties().get<std::uint32_t>(hedge::provenance::kVertexSource);
       EditMade made;
-      std::vector<std::vector<std::uint32_t>> sets;
-      std::vector<std::uint32_t> sources;
+      std::vector<Key> set;
       for (Face f : mesh.faces()) {
-        sets.emplace_back();
-        sources.clear();
+        set.clear();
         for (Vertex v : mesh.vertices(f)) {
-          sets.back().push_back(v.idx());
-          if (source && source->vector()[v.idx()] != hedge::kInvalidIndex) sources.push_back(source->vector()[v.idx()]);
+          const std::uint32_t s = source ? source->vector()[v.idx()] : hedge::kInvalidIndex;
+          const hedge::Point& p = mesh.position(v);
+          set.push_back(s != hedge::kInvalidIndex
+                            ? Key{0, s, 0, 0}
+                            : Key{1, std::bit_cast<std::uint32_t>(p[0]), std::bit_cast<std::uint32_t>(p[1]),
+                                  std::bit_cast<std::uint32_t>(p[2])});
         }
-        std::sort(sets.back().begin(), sets.back().end());
-        std::sort(sources.begin(), sources.end());
-        if (std::adjacent_find(sources.begin(), sources.end()) != sources.end()) {
-          ++made.self_welding;
-          made.self_welding_corners += sets.back().size();
+        std::sort(set.begin(), set.end());
+        const std::size_t corners = set.size();
+        const auto copies = [](const Key& a, const Key& b) { return a[0] == 0 && a == b; };
+        if (std::adjacent_find(set.begin(), set.end(), copies) != set.end()) {
+          ++made.self_welding;  // two corners on copies of one host vertex
+          made.self_welding_corners += corners;
         }
+        set.erase(std::unique(set.begin(), set.end()), set.end());
+        ++made.sets[set];
       }
-      std::sort(sets.begin(), sets.end());
-      for (std::size_t i = 1; i < sets.size(); ++i) made.duplicates += sets[i] == sets[i - 1];
       return made;
     }
-    //! What was made since `before` (nothing where the count fell).
-    EditMade minus(const EditMade& before) const {
+    //! What was made since `before`: per welded vertex set, the duplicates it gained (an edit
+    //! may remove one duplicate and make another; counts alone would miss that).
+    struct Gained {
+      std::size_t duplicates = 0, self_welding = 0, self_welding_corners = 0;
+      //! How many more of defect k (DefectCounts order) the weld of what was made may cost.
+      std::size_t allows(int k) const {
+        return k == 2 ? duplicates + self_welding : k == 3 ? self_welding : self_welding_corners;
+      }
+    };
+    Gained minus(const EditMade& before) const {
       auto gained = [](std::size_t now, std::size_t then) { return now > then ? now - then : 0; };
-      return {gained(duplicates, before.duplicates), gained(self_welding, before.self_welding),
-              gained(self_welding_corners, before.self_welding_corners)};
-    }
-    //! How many more of defect k (DefectCounts order) the weld of what was made may cost.
-    std::size_t allows(int k) const {
-      return k == 2 ? duplicates + self_welding : k == 3 ? self_welding : self_welding_corners;
+      Gained g{0, gained(self_welding, before.self_welding), gained(self_welding_corners, before.self_welding_corners)};
+      for (const auto& [set, count] : sets) {
+        const auto then = before.sets.find(set);
+        g.duplicates += gained(count, then == before.sets.end() ? 1 : std::max<std::size_t>(then->second, 1));
+      }
+      return g;
     }
   };
 
@@ -282,7 +302,7 @@ class DefectRule {
       std::fprintf(stderr, "[rule] %s: %s (allowed %zu/%zu/%zu/%zu, %zu copies kept apart)\n", what.c_str(),
                    hedge_fuzz::describe(out).c_str(), allowed_[0], allowed_[1], allowed_[2], allowed_[3],
                    report.copies_kept_apart);
-    std::optional<EditMade> made;
+    std::optional<EditMade::Gained> made;
     for (int k = 0; k < 4; ++k) {
       if (out.at(k) <= allowed_[k]) continue;
       // Only then: what the edits made in the mesh itself (counting it costs as much again).
