@@ -129,10 +129,13 @@ inline void append_le(std::string& out, T value) {
 //! and backslash line continuation (OBJ).
 class TextScanner {
  public:
-  TextScanner(std::string_view text, const std::string& name, char comment = 0, bool continuation = false)
+  //! `first_line`: the number of the text's first line, when it is a run of a file's lines.
+  TextScanner(std::string_view text, const std::string& name, char comment = 0, bool continuation = false,
+              std::size_t first_line = 1)
       : begin_(text.data()),
         p_(text.data()),
         end_(text.data() + text.size()),
+        line_(first_line),
         name_(name),
         comment_(comment),
         continuation_(continuation) {}
@@ -247,7 +250,7 @@ class TextScanner {
   const char* begin_;
   const char* p_;
   const char* end_;
-  std::size_t line_ = 1;
+  std::size_t line_;
   const std::string& name_;
   char comment_;
   bool continuation_;

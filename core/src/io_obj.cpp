@@ -2,6 +2,7 @@
 // coordinates and normals, polygons with absolute or relative indices, usemtl as a material id.
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <cstring>
 #include <string>
@@ -24,11 +25,65 @@ struct Reference {  // a vt or vn index that pointed past what the file had defi
   std::uint64_t index;  // 0-based
 };
 
-class ObjReader {
- public:
-  ObjReader(std::string_view bytes, const std::string& name) : in_(bytes, name, '#', true), name_(name) {}
+enum Kind : std::uint8_t { kVertex, kTexcoord, kNormal };
+constexpr const char* kKindNames[] = {"vertex", "texture coordinate", "normal"};
 
-  Soup read() {
+//! A relative index, which only the runs before its own can settle.
+struct Relative {
+  std::size_t corner;    // in its run
+  std::uint64_t back;    // -index - 1
+  std::uint64_t before;  // elements of its kind defined earlier in its run
+  std::size_t line;
+  Kind kind;
+  std::string text;
+};
+
+//! What one run of whole lines of the file holds. Runs are read on several threads; what
+//! depends on the lines before a run (relative indices, the material in use, whether any
+//! vertex has a colour) is kept apart and settled when the runs are joined in order.
+struct ObjRun {
+  std::vector<Point> positions;
+  std::vector<float> colors;     // 4 per vertex of the run once any of them has a colour
+  std::vector<float> texcoords;  // 2 per vt
+  std::vector<float> normals;    // 3 per vn
+  std::vector<std::uint32_t> face_sizes, corners;
+  std::vector<std::uint32_t> corner_vt, corner_vn;  // while every corner of the run has one
+  bool all_vt = true, all_vn = true;
+  std::vector<Reference> later_vt, later_vn;
+  std::vector<Relative> relative;
+  std::vector<std::string> material_names;  // by first use in the run
+  std::size_t faces_before_material = 0;    // faces before the run's first usemtl
+  std::vector<std::int32_t> materials;      // per face from there on: index into material_names
+  std::int32_t last_material = -1;          // in use at the run's end (index into material_names)
+  bool failed = false;                      // the run stopped at an error
+  std::size_t lines = 0;                    // line breaks in the run
+};
+
+class RunReader {
+ public:
+  RunReader(std::string_view bytes, const std::string& name, std::size_t first_line, ObjRun& run)
+      : in_(bytes, name, '#', true, first_line), run_(run) {}
+
+  //! Reads the run; returns its line breaks, or marks it failed at its first error.
+  std::size_t read() {
+    const std::size_t first_line = in_.line();
+    try {
+      read_statements();
+    } catch (const Error&) {
+      run_.failed = true;
+      return 0;
+    }
+    return in_.line() - first_line;
+  }
+
+  //! Reads the run again from its true first line, to throw its first error.
+  [[noreturn]] void fail_again() {
+    read_statements();
+    throw Error("internal error: a run of the file failed only once");
+  }
+
+ private:
+  void read_statements() {
     for (;;) {
       in_.skip_space();
       if (in_.at_end()) break;
@@ -38,7 +93,7 @@ class ObjReader {
       } else if (keyword == "vt") {
         read_texcoord();
       } else if (keyword == "vn") {
-        read_floats(normals_, 3, "3 normal coordinates");
+        read_floats(run_.normals, 3, "3 normal coordinates");
       } else if (keyword == "f") {
         read_face();
       } else if (keyword == "usemtl") {
@@ -50,10 +105,8 @@ class ObjReader {
       if (!in_.at_line_end()) in_.fail_expected("the end of the line", in_.line_token());
       in_.next_line();
     }
-    return finish();
   }
 
- private:
   void read_vertex() {
     Point p;
     for (int k = 0; k < 3; ++k) {
@@ -71,14 +124,15 @@ class ObjReader {
     }
     if (n == 2)
       in_.fail("expected 3 coordinates, optionally followed by a weight or by 3 or 4 colour values; found 5 values");
+    std::vector<float>& colors = run_.colors;
     if (n >= 3) {
-      if (colors_.empty()) colors_.assign(soup_.positions.size() * 4, 1.0f);
+      if (colors.empty()) colors.assign(run_.positions.size() * 4, 1.0f);
       if (n == 3) extra[3] = 1.0f;
-      colors_.insert(colors_.end(), extra, extra + 4);
-    } else if (!colors_.empty()) {
-      colors_.insert(colors_.end(), {1.0f, 1.0f, 1.0f, 1.0f});
+      colors.insert(colors.end(), extra, extra + 4);
+    } else if (!colors.empty()) {
+      colors.insert(colors.end(), {1.0f, 1.0f, 1.0f, 1.0f});
     }
-    soup_.positions.push_back(p);
+    run_.positions.push_back(p);
   }
 
   void read_texcoord() {
@@ -90,8 +144,8 @@ class ObjReader {
       ++n;
     }
     if (n == 0) in_.fail("expected 1 to 3 texture coordinates, found end of line");
-    texcoords_.push_back(uvw[0]);
-    texcoords_.push_back(uvw[1]);
+    run_.texcoords.push_back(uvw[0]);
+    run_.texcoords.push_back(uvw[1]);
   }
 
   void read_floats(std::vector<float>& out, int n, const char* what) {
@@ -103,27 +157,30 @@ class ObjReader {
     }
   }
 
-  //! A 1-based or negative (relative) index into `count` elements defined so far, 0-based.
-  std::uint64_t resolve(std::string_view text, std::string_view token, std::size_t count, const char* kind) {
+  //! A 1-based index, 0-based; a negative (relative) one is recorded for the join to settle
+  //! against everything defined before it, and kNone stands in for it until then.
+  std::uint64_t resolve(std::string_view text, std::string_view token, std::size_t before, Kind kind) {
+    const char* name = kKindNames[kind];
     std::int64_t i = 0;
     if (!parse_number(text, i))
-      in_.fail("expected a " + std::string(kind) + " index in " + quote(token) + ", found " + quote(text));
+      in_.fail("expected a " + std::string(name) + " index in " + quote(token) + ", found " + quote(text));
     if (i > 0) {
       if (static_cast<std::uint64_t>(i) > 0xffffffffu)
-        in_.fail(std::string(kind) + " index " + std::string(text) + " is too large");
+        in_.fail(std::string(name) + " index " + std::string(text) + " is too large");
       return static_cast<std::uint64_t>(i - 1);
     }
     if (i == 0) in_.fail("index 0 in " + quote(token) + " is invalid: OBJ indices start at 1");
-    if (static_cast<std::uint64_t>(-(i + 1)) >= count)
-      in_.fail("relative " + std::string(kind) + " index " + std::string(text) + " points before the first " + kind +
-               " (only " + std::to_string(count) + " defined so far)");
-    return count - static_cast<std::uint64_t>(-(i + 1)) - 1;
+    const std::size_t corner = run_.corners.size() - (kind == kVertex ? 0 : 1);
+    run_.relative.push_back(
+        {corner, static_cast<std::uint64_t>(-(i + 1)), before, in_.line(), kind, std::string(text)});
+    return kNone;
   }
 
-  std::uint32_t attribute(std::string_view text, std::string_view token, std::size_t count, const char* kind,
+  std::uint32_t attribute(std::string_view text, std::string_view token, std::size_t before, Kind kind,
                           std::vector<Reference>& later) {
-    std::uint64_t index = resolve(text, token, count, kind);
-    if (index >= count) later.push_back({in_.line(), index});
+    const std::uint64_t index = resolve(text, token, before, kind);
+    // Past what this run has defined so far: checked against the whole file at the end.
+    if (index != kNone && index >= before) later.push_back({in_.line(), index});
     return static_cast<std::uint32_t>(index);
   }
 
@@ -141,78 +198,214 @@ class ObjReader {
         if (slash == std::string_view::npos) break;
         start = slash + 1;
       }
-      std::uint64_t v = resolve(parts[0], token, soup_.positions.size(), "vertex");
-      soup_.corners.push_back(static_cast<std::uint32_t>(v));
-      std::uint32_t vt = kNone, vn = kNone;
-      if (n > 1 && !parts[1].empty())
-        vt = attribute(parts[1], token, texcoords_.size() / 2, "texture coordinate", later_vt_);
-      if (n > 2 && !parts[2].empty()) vn = attribute(parts[2], token, normals_.size() / 3, "normal", later_vn_);
-      all_vt_ = all_vt_ && vt != kNone;
-      all_vn_ = all_vn_ && vn != kNone;
-      if (all_vt_) corner_vt_.push_back(vt);
-      if (all_vn_) corner_vn_.push_back(vn);
+      const std::uint64_t v = resolve(parts[0], token, run_.positions.size(), kVertex);
+      run_.corners.push_back(static_cast<std::uint32_t>(v));
+      const bool has_vt = n > 1 && !parts[1].empty(), has_vn = n > 2 && !parts[2].empty();
+      run_.all_vt = run_.all_vt && has_vt;
+      run_.all_vn = run_.all_vn && has_vn;
+      // Pushed before being resolved, so that a relative index names its corner.
+      if (run_.all_vt) run_.corner_vt.push_back(kNone);
+      if (has_vt) {
+        const std::uint32_t vt = attribute(parts[1], token, run_.texcoords.size() / 2, kTexcoord, run_.later_vt);
+        if (run_.all_vt) run_.corner_vt.back() = vt;
+      }
+      if (run_.all_vn) run_.corner_vn.push_back(kNone);
+      if (has_vn) {
+        const std::uint32_t vn = attribute(parts[2], token, run_.normals.size() / 3, kNormal, run_.later_vn);
+        if (run_.all_vn) run_.corner_vn.back() = vn;
+      }
       ++size;
     }
     if (size == 0) in_.fail("expected vertex indices after 'f', found end of line");
-    soup_.face_sizes.push_back(size);
-    if (seen_material_) materials_.push_back(material_);
+    run_.face_sizes.push_back(size);
+    if (seen_material_) run_.materials.push_back(material_);
   }
 
   void use_material() {
     std::string_view name = in_.line_token();
     while (!in_.at_line_end()) in_.line_token();  // names with spaces: the first word decides
     auto [it, added] = material_ids_.try_emplace(std::string(name), static_cast<std::int32_t>(material_ids_.size()));
-    material_ = it->second;
-    if (!seen_material_) materials_.assign(soup_.face_sizes.size(), -1);
+    if (added) run_.material_names.emplace_back(name);
+    material_ = run_.last_material = it->second;
+    if (!seen_material_) run_.faces_before_material = run_.face_sizes.size();
     seen_material_ = true;
   }
 
-  void check_later(const std::vector<Reference>& later, std::size_t count, const char* kind) {
-    for (const Reference& r : later)
-      if (r.index >= count)
-        fail_line(name_, r.line,
-                  std::string(kind) + " index " + std::to_string(r.index + 1) + " is out of range: the file defines " +
-                      std::to_string(count));
-  }
-
-  Soup finish() {
-    check_later(later_vt_, texcoords_.size() / 2, "texture coordinate");
-    check_later(later_vn_, normals_.size() / 3, "normal");
-    if (!colors_.empty()) {
-      Channel& c = soup_.add_channel("color", Domain::vertex, ScalarType::f32, 4);
-      std::memcpy(c.data.data(), colors_.data(), colors_.size() * sizeof(float));
-    }
-    if (seen_material_) {
-      Channel& c = soup_.add_channel("material", Domain::face, ScalarType::i32, 1);
-      if (!materials_.empty()) std::memcpy(c.data.data(), materials_.data(), materials_.size() * sizeof(std::int32_t));
-    }
-    if (all_vt_ && soup_.n_corners() > 0) {
-      Channel& c = soup_.add_channel("uv", Domain::corner, ScalarType::f32, 2);
-      float* uv = c.as<float>();
-      for (std::size_t i = 0; i < corner_vt_.size(); ++i)
-        std::memcpy(uv + 2 * i, &texcoords_[2 * corner_vt_[i]], 2 * sizeof(float));
-    }
-    if (all_vn_ && soup_.n_corners() > 0) {
-      Channel& c = soup_.add_channel("normal", Domain::corner, ScalarType::f32, 3);
-      float* n = c.as<float>();
-      for (std::size_t i = 0; i < corner_vn_.size(); ++i)
-        std::memcpy(n + 3 * i, &normals_[3 * corner_vn_[i]], 3 * sizeof(float));
-    }
-    check_soup(soup_, name_);
-    return std::move(soup_);
-  }
-
   TextScanner in_;
+  ObjRun& run_;
+  std::unordered_map<std::string, std::int32_t> material_ids_;  // the run's own numbering
+  std::int32_t material_ = -1;
+  bool seen_material_ = false;
+};
+
+//! Cuts the file into runs of whole lines, about `bytes` each: after a line break that no
+//! backslash continues.
+std::vector<std::string_view> cut_into_runs(std::string_view text, std::size_t bytes) {
+  std::vector<std::string_view> runs;
+  std::size_t begin = 0;
+  while (begin < text.size()) {
+    std::size_t end = begin + bytes;
+    for (;;) {
+      if (end >= text.size()) {
+        end = text.size();
+        break;
+      }
+      end = text.find('\n', end);
+      if (end == std::string_view::npos) {
+        end = text.size();
+        break;
+      }
+      std::size_t before = end;
+      if (before > begin && text[before - 1] == '\r') --before;
+      ++end;
+      if (before == begin || text[before - 1] != '\\') break;
+    }
+    runs.push_back(text.substr(begin, end - begin));
+    begin = end;
+  }
+  return runs;
+}
+
+//! Joins the runs in order: indices settled, materials numbered by first use in the file,
+//! errors reported in the order the file has them.
+class RunJoin {
+ public:
+  RunJoin(std::vector<ObjRun>& runs, const std::vector<std::string_view>& text, const std::string& name)
+      : runs_(runs), text_(text), name_(name) {}
+
+  Soup join() {
+    std::uint64_t defined[3] = {0, 0, 0};
+    bool colors = false, all_vt = true, all_vn = true;
+    std::size_t lines_before = 0;
+    for (std::size_t k = 0; k < runs_.size(); ++k) {
+      ObjRun& run = runs_[k];
+      for (Relative& r : run.relative) settle(run, r, defined[r.kind] + r.before, lines_before);
+      if (run.failed) {
+        ObjRun again;
+        RunReader(text_[k], name_, lines_before + 1, again).fail_again();
+      }
+      for (Reference& r : run.later_vt) r.line += lines_before;
+      for (Reference& r : run.later_vn) r.line += lines_before;
+      lines_before += run.lines;
+      Start& at = starts_.emplace_back();
+      at.vertices = defined[kVertex], at.texcoords = defined[kTexcoord], at.normals = defined[kNormal];
+      at.corners = corners_, at.faces = faces_;
+      defined[kVertex] += run.positions.size();
+      defined[kTexcoord] += run.texcoords.size() / 2;
+      defined[kNormal] += run.normals.size() / 3;
+      corners_ += run.corners.size();
+      faces_ += run.face_sizes.size();
+      colors = colors || !run.colors.empty();
+      all_vt = all_vt && run.all_vt;
+      all_vn = all_vn && run.all_vn;
+      number_materials(run);
+    }
+    check_later(&ObjRun::later_vt, defined[kTexcoord], kTexcoord);
+    check_later(&ObjRun::later_vn, defined[kNormal], kNormal);
+
+    Soup soup;
+    soup.positions.resize(defined[kVertex]);
+    soup.face_sizes.resize(faces_);
+    soup.corners.resize(corners_);
+    std::vector<float> texcoords(2 * defined[kTexcoord]), normals(3 * defined[kNormal]);
+    float* color = colors ? soup.add_channel("color", Domain::vertex, ScalarType::f32, 4).as<float>() : nullptr;
+    std::int32_t* material =
+        seen_material_ ? soup.add_channel("material", Domain::face, ScalarType::i32, 1).as<std::int32_t>() : nullptr;
+    each_run([&](const ObjRun& run, const Start& at) {
+      std::copy(run.positions.begin(), run.positions.end(), soup.positions.begin() + std::ptrdiff_t(at.vertices));
+      std::copy(run.face_sizes.begin(), run.face_sizes.end(), soup.face_sizes.begin() + std::ptrdiff_t(at.faces));
+      std::copy(run.corners.begin(), run.corners.end(), soup.corners.begin() + std::ptrdiff_t(at.corners));
+      std::copy(run.texcoords.begin(), run.texcoords.end(), texcoords.begin() + std::ptrdiff_t(2 * at.texcoords));
+      std::copy(run.normals.begin(), run.normals.end(), normals.begin() + std::ptrdiff_t(3 * at.normals));
+      if (color) {
+        float* out = color + 4 * at.vertices;
+        if (run.colors.empty())
+          std::fill(out, out + 4 * run.positions.size(), 1.0f);
+        else
+          std::copy(run.colors.begin(), run.colors.end(), out);
+      }
+      if (material) {
+        std::int32_t* out = material + at.faces;
+        const std::size_t inherited = run.materials.empty() ? run.face_sizes.size() : run.faces_before_material;
+        std::fill(out, out + inherited, at.material);
+        for (std::size_t f = inherited; f < run.face_sizes.size(); ++f)
+          out[f] = at.material_ids[std::size_t(run.materials[f - inherited])];
+      }
+    });
+    if (all_vt && corners_ > 0)
+      gather(soup.add_channel("uv", Domain::corner, ScalarType::f32, 2), texcoords, 2, &ObjRun::corner_vt);
+    if (all_vn && corners_ > 0)
+      gather(soup.add_channel("normal", Domain::corner, ScalarType::f32, 3), normals, 3, &ObjRun::corner_vn);
+    check_soup(soup, name_);
+    return soup;
+  }
+
+ private:
+  struct Start {  // what the runs before a run define
+    std::uint64_t vertices = 0, texcoords = 0, normals = 0, corners = 0, faces = 0;
+    std::int32_t material = -1;              // in use where the run starts
+    std::vector<std::int32_t> material_ids;  // the run's material numbers in the file's
+  };
+
+  void settle(ObjRun& run, const Relative& r, std::uint64_t defined, std::size_t lines_before) {
+    const char* kind = kKindNames[r.kind];
+    if (r.back >= defined)
+      fail_line(name_, lines_before + r.line,
+                "relative " + std::string(kind) + " index " + r.text + " points before the first " + kind + " (only " +
+                    std::to_string(defined) + " defined so far)");
+    const auto index = static_cast<std::uint32_t>(defined - r.back - 1);
+    if (r.kind == kVertex) run.corners[r.corner] = index;
+    std::vector<std::uint32_t>& of_corner = r.kind == kTexcoord ? run.corner_vt : run.corner_vn;
+    if (r.kind != kVertex && r.corner < of_corner.size()) of_corner[r.corner] = index;
+  }
+
+  void number_materials(const ObjRun& run) {
+    Start& at = starts_.back();
+    at.material = material_;
+    for (const std::string& m : run.material_names) {
+      auto it = material_ids_.try_emplace(m, static_cast<std::int32_t>(material_ids_.size())).first;
+      at.material_ids.push_back(it->second);
+    }
+    if (run.last_material >= 0) {
+      seen_material_ = true;
+      material_ = at.material_ids[std::size_t(run.last_material)];
+    }
+  }
+
+  void check_later(std::vector<Reference> ObjRun::*later, std::uint64_t count, Kind kind) {
+    for (const ObjRun& run : runs_)
+      for (const Reference& r : run.*later)
+        if (r.index >= count)
+          fail_line(name_, r.line,
+                    std::string(kKindNames[kind]) + " index " + std::to_string(r.index + 1) +
+                        " is out of range: the file defines " + std::to_string(count));
+  }
+
+  template <class Fn>
+  void each_run(Fn&& fn) {
+    parallel_for(
+        runs_.size(), 0,
+        [&](std::size_t begin, std::size_t end) {
+          for (std::size_t r = begin; r < end; ++r) fn(runs_[r], starts_[r]);
+        },
+        1);
+  }
+
+  void gather(Channel& c, const std::vector<float>& values, int n, std::vector<std::uint32_t> ObjRun::*of_corner) {
+    float* out = c.as<float>();
+    each_run([&](const ObjRun& run, const Start& at) {
+      const std::vector<std::uint32_t>& index = run.*of_corner;
+      for (std::size_t i = 0; i < index.size(); ++i)
+        std::memcpy(out + n * (at.corners + i), &values[std::size_t(n) * index[i]], n * sizeof(float));
+    });
+  }
+
+  std::vector<ObjRun>& runs_;
+  const std::vector<std::string_view>& text_;
   const std::string& name_;
-  Soup soup_;
-  std::vector<float> colors_;     // 4 per vertex once any vertex has a colour
-  std::vector<float> texcoords_;  // 2 per vt
-  std::vector<float> normals_;    // 3 per vn
-  std::vector<std::uint32_t> corner_vt_, corner_vn_;
-  std::vector<Reference> later_vt_, later_vn_;
-  bool all_vt_ = true, all_vn_ = true;
+  std::vector<Start> starts_;
+  std::uint64_t corners_ = 0, faces_ = 0;
   std::unordered_map<std::string, std::int32_t> material_ids_;
-  std::vector<std::int32_t> materials_;
   std::int32_t material_ = -1;
   bool seen_material_ = false;
 };
@@ -272,7 +465,23 @@ class Dedup {
 
 }  // namespace
 
-Soup read_obj(std::string_view bytes, const std::string& name) { return ObjReader(bytes, name).read(); }
+Soup read_obj(std::string_view bytes, const std::string& name) {
+  // Runs of about 1 MB, read on all threads, each numbering its lines from 1 (the join adds
+  // the lines before it).
+  const std::size_t run_bytes = testing::parallel_grain() ? testing::parallel_grain() : std::size_t(1) << 20;
+  const std::vector<std::string_view> text = cut_into_runs(bytes, run_bytes);
+  std::vector<ObjRun> runs(text.size());
+  // Each thread takes the next run left: a run of faces takes longer than one of vertices.
+  std::atomic<std::size_t> next{0};
+  parallel_for(
+      std::min<std::size_t>(runs.size(), resolve_thread_count(0)), 0,
+      [&](std::size_t, std::size_t) {
+        for (std::size_t r; (r = next.fetch_add(1)) < runs.size();)
+          runs[r].lines = RunReader(text[r], name, 1, runs[r]).read();
+      },
+      1);
+  return RunJoin(runs, text, name).join();
+}
 
 std::string write_obj(const Soup& soup) {
   soup.check();

@@ -22,6 +22,7 @@
 #include <string>
 #include <thread>
 #include <tuple>
+#include <variant>
 #include <vector>
 
 #include "hedge/error.h"
@@ -430,6 +431,54 @@ TEST(IoObj, RoundTrip) {
   std::size_t vt_lines = 0;
   for (std::size_t p = text.find("\nvt "); p != std::string::npos; p = text.find("\nvt ", p + 1)) ++vt_lines;
   EXPECT_EQ(vt_lines, 5u);
+}
+
+TEST(IoObj, RunsOfAnySizeReadAsTheWholeFile) {
+  // The reader cuts a file into runs of lines, read on several threads and joined: every
+  // run size gives the soup, or the error (line and message), of the file read whole.
+  const std::vector<std::string> files = {
+      "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0 0.5 0.25 1\nvt 0 0\nvt 1 0\nvn 0 0 1\n"
+      "f 1/1/1 2/2/1 3/1/1\nusemtl a\nf -4/-2/-1 -3/-1/-1 -1/-2/-1\nf 2 4 3\n# a comment \\\nusemtl b\n"
+      "f 1/3 2/4 3/3\nvt 0.5 0.5\nusemtl a\nf 2/1 4/2 \\\n 3/1\nvt 1 1\nusemtl c\n",
+      "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nv 1 1 0\nf -1 -3 -2\nusemtl m\n",
+      "v 0 0 0\r\nv 1 0 0\r\nv 0 1 \\\r\n 0\r\nf 1 2 3\r\n",
+      // Errors: the first in the file wins, wherever the runs are cut.
+      "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 -4\nf 1 2 x\n",
+      "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x\nf 1 2 -4\n",
+      "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/1 2/1 3/9\nv 1 2\n",
+      "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/1 2/1 3/9\nvt 0 0\n",
+      "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/-2 2/1 3/1\n",
+      "v 0 0 0\nv 1 0 0\nf 1 2 3\n",
+      "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nv 1 2 \\\n",
+      "v 0 0 0\nv 1 0 0\nv 0 1 0\n\n\nf 1 2 3 junk/1/2/3\n",
+  };
+  auto read = [](const std::string& text) -> std::variant<Soup, std::string> {
+    try {
+      return read_obj(text, "runs.obj");
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+  };
+  for (const std::string& text : files) {
+    const auto whole = read(text);
+    for (std::size_t run_bytes : {1, 2, 3, 5, 8, 13, 21, 64}) {
+      set_thread_count(2);
+      testing::set_parallel_grain(run_bytes);
+      const auto in_runs = read(text);
+      set_thread_count(0);
+      testing::set_parallel_grain(0);
+      ASSERT_EQ(whole.index(), in_runs.index()) << text << "\nruns of " << run_bytes << " bytes";
+      if (whole.index() == 0)
+        EXPECT_TRUE(std::get<Soup>(whole) == std::get<Soup>(in_runs)) << text << "\nruns of " << run_bytes << " bytes";
+      else
+        EXPECT_EQ(std::get<std::string>(whole), std::get<std::string>(in_runs)) << "runs of " << run_bytes << " bytes";
+    }
+  }
+  // What the first file holds, read whole.
+  const Soup s = std::get<Soup>(read(files[0]));
+  EXPECT_EQ(s.n_faces(), 5u);
+  EXPECT_EQ(values<std::int32_t>(channel(s, "material", Domain::face)), (std::vector<std::int32_t>{-1, 0, 0, 1, 0}));
+  EXPECT_EQ(s.corners, (std::vector<std::uint32_t>{0, 1, 2, 0, 1, 3, 1, 3, 2, 0, 1, 2, 1, 3, 2}));
 }
 
 TEST(IoObj, Errors) {
