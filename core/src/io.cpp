@@ -200,23 +200,36 @@ Soup read_mesh(const std::string& path) {
   throw Error(path + ": unknown format");
 }
 
+std::string io_detail::Pieces::joined() && {
+  if (parts.size() == 1) return std::move(parts[0]);
+  std::size_t total = 0;
+  for (const std::string& part : parts) total += part.size();
+  std::string out;
+  out.reserve(total);
+  for (std::string& part : parts) {
+    out += part;
+    std::string().swap(part);  // each piece's memory goes as soon as it is copied
+  }
+  return out;
+}
+
 void write_mesh(const Soup& soup, const std::string& path, const WriteOptions& options) {
   FileFormat format = format_from_path(path);
   // Everything is formatted before the file is touched, so a soup the writer refuses
   // leaves an existing file as it was.
-  std::string bytes;
+  io_detail::Pieces bytes;
   switch (format) {
     case FileFormat::off:
-      bytes = write_off(soup);
+      bytes = io_detail::format_off(soup);
       break;
     case FileFormat::obj:
-      bytes = write_obj(soup);
+      bytes = io_detail::format_obj(soup);
       break;
     case FileFormat::ply:
-      bytes = write_ply(soup, options.binary);
+      bytes = io_detail::format_ply(soup, options.binary);
       break;
     case FileFormat::stl:
-      bytes = write_stl(soup, options.binary);
+      bytes = io_detail::format_stl(soup, options.binary);
       break;
   }
 
@@ -231,16 +244,19 @@ void write_mesh(const Soup& soup, const std::string& path, const WriteOptions& o
     ::unlink(temp.c_str());
     throw Error("cannot write " + path + ": " + system_reason(error));
   };
-  const char* p = bytes.data();
-  std::size_t left = bytes.size();
-  while (left > 0) {
-    ssize_t n = ::write(fd, p, left);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      give_up(errno);
+  for (std::string& part : bytes.parts) {
+    const char* p = part.data();
+    std::size_t left = part.size();
+    while (left > 0) {
+      ssize_t n = ::write(fd, p, left);
+      if (n < 0) {
+        if (errno == EINTR) continue;
+        give_up(errno);
+      }
+      p += n;
+      left -= static_cast<std::size_t>(n);
     }
-    p += n;
-    left -= static_cast<std::size_t>(n);
+    std::string().swap(part);  // written: its memory goes
   }
   if (::fsync(fd) != 0 && errno != EINVAL && errno != EROFS) give_up(errno);
   if (::close(fd) != 0) {

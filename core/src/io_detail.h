@@ -71,32 +71,46 @@ inline void append_number(std::string& out, T value) {
   out.append(buffer, result.ptr);
 }
 
-//! Appends the text (or bytes) of elements [0, n), element i written by write(out, i). Runs
-//! of elements are written on several threads, each into a string of its own, and joined
-//! in order: the same bytes as one pass. Formatting numbers is most of a writer's time.
+//! A file's contents as pieces, in order: what writers format on several threads is kept
+//! as it comes rather than copied into one string (write_mesh() writes the pieces as they
+//! are; the write_*() functions join them).
+struct Pieces {
+  std::vector<std::string> parts;
+  std::string joined() &&;
+};
+
+Pieces format_off(const Soup& soup);
+Pieces format_obj(const Soup& soup);
+Pieces format_ply(const Soup& soup, bool binary);
+Pieces format_stl(const Soup& soup, bool binary);
+
+//! Appends the text (or bytes) of elements [0, n), element i written by write(text, i), to
+//! `out`, or, for many elements, moves `out` into `pieces` and adds runs of elements
+//! written on several threads, each into a string of its own: the same bytes in order as one
+//! pass. Formatting numbers is most of a writer's time.
 template <class Write>
-void append_elements(std::string& out, std::size_t n, Write&& write) {
+void append_elements(Pieces& pieces, std::string& out, std::size_t n, Write&& write) {
   const std::size_t per_run = testing::parallel_grain() ? testing::parallel_grain() : std::size_t(1) << 16;
   const std::size_t runs = (n + per_run - 1) / per_run;
   if (runs <= 1) {
     for (std::size_t i = 0; i < n; ++i) write(out, i);
     return;
   }
+  // Room for 128 bytes an element, so that a run's string is seldom copied as it grows
+  // (pages never touched cost nothing).
   std::vector<std::string> text(runs);
   parallel_for(
       runs, 0,
       [&](std::size_t begin, std::size_t end) {
-        for (std::size_t r = begin; r < end; ++r)
+        for (std::size_t r = begin; r < end; ++r) {
+          text[r].reserve((n * (r + 1) / runs - n * r / runs) * 128);
           for (std::size_t i = n * r / runs; i < n * (r + 1) / runs; ++i) write(text[r], i);
+        }
       },
       1);
-  std::size_t total = out.size();
-  for (const std::string& t : text) total += t.size();
-  out.reserve(total);
-  for (std::string& t : text) {
-    out += t;
-    std::string().swap(t);  // each run's memory goes as soon as it is copied
-  }
+  pieces.parts.push_back(std::move(out));
+  out.clear();
+  for (std::string& t : text) pieces.parts.push_back(std::move(t));
 }
 
 //! Little- or big-endian loads and stores of numbers, whatever the host's order.

@@ -483,7 +483,8 @@ Soup read_obj(std::string_view bytes, const std::string& name) {
   return RunJoin(runs, text, name).join();
 }
 
-std::string write_obj(const Soup& soup) {
+Pieces io_detail::format_obj(const Soup& soup) {
+  Pieces pieces;
   soup.check();
   const std::size_t nc = soup.n_corners();
   std::vector<std::size_t> offsets = soup.face_offsets();
@@ -517,7 +518,7 @@ std::string write_obj(const Soup& soup) {
     color = nullptr;
 
   std::string out = "# written by hedge\n";
-  append_elements(out, soup.n_vertices(), [&](std::string& text, std::size_t v) {
+  append_elements(pieces, out, soup.n_vertices(), [&](std::string& text, std::size_t v) {
     text += 'v';
     for (int k = 0; k < 3; ++k) {
       text += ' ';
@@ -535,14 +536,14 @@ std::string write_obj(const Soup& soup) {
     }
     text += '\n';
   });
-  append_elements(out, uvs.values().size() / 2, [&](std::string& text, std::size_t i) {
+  append_elements(pieces, out, uvs.values().size() / 2, [&](std::string& text, std::size_t i) {
     text += "vt ";
     append_number(text, uvs.values()[2 * i]);
     text += ' ';
     append_number(text, uvs.values()[2 * i + 1]);
     text += '\n';
   });
-  append_elements(out, normals.values().size() / 3, [&](std::string& text, std::size_t i) {
+  append_elements(pieces, out, normals.values().size() / 3, [&](std::string& text, std::size_t i) {
     text += "vn";
     for (int k = 0; k < 3; ++k) {
       text += ' ';
@@ -550,7 +551,7 @@ std::string write_obj(const Soup& soup) {
     }
     text += '\n';
   });
-  append_elements(out, soup.n_faces(), [&](std::string& text, std::size_t f) {
+  append_elements(pieces, out, soup.n_faces(), [&](std::string& text, std::size_t f) {
     if (material) {
       // A face opens a new material group where its material differs from the face before.
       const std::int32_t m = material->as<std::int32_t>()[f];
@@ -575,7 +576,10 @@ std::string write_obj(const Soup& soup) {
     }
     text += '\n';
   });
-  return out;
+  pieces.parts.push_back(std::move(out));
+  return pieces;
 }
+
+std::string write_obj(const Soup& soup) { return format_obj(soup).joined(); }
 
 }  // namespace hedge

@@ -232,7 +232,8 @@ void append_color(std::string& out, std::array<std::uint8_t, 4> rgba) {
 
 }  // namespace
 
-std::string write_off(const Soup& soup) {
+Pieces io_detail::format_off(const Soup& soup) {
+  Pieces pieces;
   soup.check();
   const Channel* normals = find_channel(soup, "normal", Domain::vertex, ScalarType::f32, 3);
   const Channel* uvs = find_channel(soup, "uv", Domain::vertex, ScalarType::f32, 2);
@@ -248,7 +249,7 @@ std::string write_off(const Soup& soup) {
   out += ' ';
   append_number(out, soup.n_faces());
   out += " 0\n";
-  append_elements(out, soup.n_vertices(), [&](std::string& text, std::size_t v) {
+  append_elements(pieces, out, soup.n_vertices(), [&](std::string& text, std::size_t v) {
     for (int k = 0; k < 3; ++k) {
       if (k) text += ' ';
       append_number(text, soup.positions[v][k]);
@@ -267,7 +268,7 @@ std::string write_off(const Soup& soup) {
     text += '\n';
   });
   const std::vector<std::size_t> offsets = soup.face_offsets();
-  append_elements(out, soup.n_faces(), [&](std::string& text, std::size_t f) {
+  append_elements(pieces, out, soup.n_faces(), [&](std::string& text, std::size_t f) {
     append_number(text, soup.face_sizes[f]);
     for (std::size_t c = offsets[f]; c < offsets[f + 1]; ++c) {
       text += ' ';
@@ -276,7 +277,10 @@ std::string write_off(const Soup& soup) {
     if (face_colors) append_color(text, face_colors[f]);
     text += '\n';
   });
-  return out;
+  pieces.parts.push_back(std::move(out));
+  return pieces;
 }
+
+std::string write_off(const Soup& soup) { return format_off(soup).joined(); }
 
 }  // namespace hedge

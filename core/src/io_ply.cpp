@@ -673,7 +673,8 @@ class Writer {
 
 }  // namespace
 
-std::string write_ply(const Soup& soup, bool binary) {
+Pieces io_detail::format_ply(const Soup& soup, bool binary) {
+  Pieces pieces;
   soup.check();
   const Channel* normals = find_channel(soup, "normal", Domain::vertex, ScalarType::f32, 3);
   ColorView colors = find_color(soup, Domain::vertex);
@@ -711,7 +712,7 @@ std::string write_ply(const Soup& soup, bool binary) {
   if (material) out += "property int material_index\n";
   if (face_selected) out += "property uchar selected\n";
   out += "end_header\n";
-  append_elements(out, soup.n_vertices(), [&](std::string& text, std::size_t v) {
+  append_elements(pieces, out, soup.n_vertices(), [&](std::string& text, std::size_t v) {
     Writer w(text, binary);
     for (int k = 0; k < 3; ++k) w.value(soup.positions[v][k]);
     if (normals)
@@ -725,7 +726,7 @@ std::string write_ply(const Soup& soup, bool binary) {
     w.end_element();
   });
   const std::vector<std::size_t> offsets = soup.face_offsets();
-  append_elements(out, soup.n_faces(), [&](std::string& text, std::size_t f) {
+  append_elements(pieces, out, soup.n_faces(), [&](std::string& text, std::size_t f) {
     Writer w(text, binary);
     const std::size_t corner = offsets[f];
     const std::uint32_t size = soup.face_sizes[f];
@@ -753,7 +754,10 @@ std::string write_ply(const Soup& soup, bool binary) {
     if (face_selected) w.value(face_selected->as<std::uint8_t>()[f]);
     w.end_element();
   });
-  return out;
+  pieces.parts.push_back(std::move(out));
+  return pieces;
 }
+
+std::string write_ply(const Soup& soup, bool binary) { return format_ply(soup, binary).joined(); }
 
 }  // namespace hedge

@@ -189,7 +189,8 @@ Soup read_stl(std::string_view bytes, const std::string& name) {
   return read_binary(bytes, static_cast<std::uint32_t>(triangles), name);
 }
 
-std::string write_stl(const Soup& soup, bool binary) {
+Pieces io_detail::format_stl(const Soup& soup, bool binary) {
+  Pieces pieces;
   soup.check();
   std::uint64_t triangles = 0;
   for (std::uint32_t s : soup.face_sizes)
@@ -200,18 +201,16 @@ std::string write_stl(const Soup& soup, bool binary) {
 
   std::string out;
   if (binary) {
-    out.reserve(kHeaderBytes + kTriangleBytes * triangles);
     // Not "solid ...": readers take a header starting with that for ASCII.
     std::string header = "binary STL written by hedge";
     header.resize(80, ' ');
     out += header;
     append_le(out, static_cast<std::uint32_t>(triangles));
   } else {
-    out.reserve(triangles * 250);
     out += "solid hedge\n";
   }
   const std::vector<std::size_t> offsets = soup.face_offsets();
-  append_elements(out, soup.n_faces(), [&](std::string& text, std::size_t f) {
+  append_elements(pieces, out, soup.n_faces(), [&](std::string& text, std::size_t f) {
     auto vertex = [&](const Point& p) {
       if (binary) {
         for (int k = 0; k < 3; ++k) append_le(text, p[k]);
@@ -250,7 +249,10 @@ std::string write_stl(const Soup& soup, bool binary) {
     }
   });
   if (!binary) out += "endsolid hedge\n";
-  return out;
+  pieces.parts.push_back(std::move(out));
+  return pieces;
 }
+
+std::string write_stl(const Soup& soup, bool binary) { return format_stl(soup, binary).joined(); }
 
 }  // namespace hedge
