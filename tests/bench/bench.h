@@ -191,5 +191,7 @@ int run_operation_table(int reps, bool hosts, const std::vector<std::string>& on
 //! --scale (scale.cpp): the pipeline on 10M+ triangles and cost per triangle by size;
 //! growth_only skips the pipeline.
 int run_scale(const std::string& dragon_path, bool growth_only);
+//! --files (files.cpp): each format written and read in memory, fastest of `reps`.
+int run_files(const std::string& path, int reps);
 
 }  // namespace bench

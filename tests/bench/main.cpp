@@ -261,6 +261,8 @@ void usage() {
       "                 loop, catmull, sqrt3, smooth); repeatable\n"
       "  --scale        instead: the pipeline on the mesh Loop-subdivided to 10M+ triangles, and\n"
       "                 build/decimate cost per triangle from 100k to 14M (--scale-growth: only that)\n"
+      "  --files        instead: each file format written and read in memory (fastest of --op-reps),\n"
+      "                 the mesh Loop-subdivided once with a uv per corner\n"
       "  --threads N    threads hedge may use (default: all cores); the peers run on one\n");
   benchmark::PrintDefaultHelp();
 }
@@ -272,7 +274,7 @@ double min_statistic(const std::vector<double>& v) { return bench::min_of(v); }
 int main(int argc, char** argv) {
   std::string dir = "build/meshes", mesh = "dragon.ply";
   int reps = 10, op_reps = 1;
-  bool ops = false, hosts = false;
+  bool ops = false, hosts = false, files = false;
   std::vector<std::string> only_ops;  // --op NAME, repeatable
   std::string scale;
   std::vector<char*> rest = {argv[0]};
@@ -314,6 +316,10 @@ int main(int argc, char** argv) {
       hedge::set_thread_count(static_cast<unsigned>(std::max(0, std::atoi(reps_text.c_str()))));
       continue;
     }
+    if (a == "--files") {
+      files = true;
+      continue;
+    }
     if (a == "--scale" || a == "--scale-growth") {
       scale = a;
       continue;
@@ -332,6 +338,7 @@ int main(int argc, char** argv) {
   std::string path = mesh;
   if (mesh.find('/') == std::string::npos) path = (std::filesystem::path(dir) / mesh).string();
   if (!scale.empty()) return bench::run_scale(path, scale == "--scale-growth");
+  if (files) return bench::run_files(path, op_reps);
 
   // Operation-major order, so each row's libraries run back to back in the same conditions.
   std::vector<std::vector<bench::Entry>> libraries = {bench::hedge_benchmarks(), bench::openmesh_benchmarks(),
