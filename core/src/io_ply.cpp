@@ -3,10 +3,12 @@
 // quality/material, per-corner uv (MeshLab's texcoord list), and a vertex or face "selected"
 // (any scalar, non-zero when selected; hedge's own convention); anything else is skipped.
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -292,7 +294,46 @@ struct Sink {
   bool has_normal = false, has_vertex_color = false, has_vertex_quality = false, has_vertex_uv = false;
   bool has_face_color = false, has_face_quality = false, has_material = false, has_texcoord = false;
   bool has_vertex_selected = false, has_face_selected = false;
+  // The first vertex and face these arrays hold (a run of the file holds a range of each).
+  std::uint64_t vertex_base = 0, face_base = 0;
+
+  //! Which channels the header's properties fill.
+  void take_targets(const Header& header) {
+    for (const PlyElement& e : header.elements)
+      for (const PlyProperty& p : e.properties) {
+        if (e.kind == Kind::vertex) {
+          has_normal |= p.target == Target::normal;
+          has_vertex_color |= p.target == Target::color;
+          has_vertex_quality |= p.target == Target::quality;
+          has_vertex_uv |= p.target == Target::uv;
+          has_vertex_selected |= p.target == Target::selected;
+        } else if (e.kind == Kind::face) {
+          has_face_color |= p.target == Target::color;
+          has_face_quality |= p.target == Target::quality;
+          has_material |= p.target == Target::material;
+          has_texcoord |= p.target == Target::texcoord;
+          has_face_selected |= p.target == Target::selected;
+        }
+      }
+  }
+  //! Room for nv vertices and nf faces, with their defaults.
+  void size(std::uint64_t nv, std::uint64_t nf) {
+    soup.positions.resize(nv);
+    if (has_normal) normals.resize(3 * nv);
+    if (has_vertex_color) vertex_color.resize(4 * nv, 255);
+    if (has_vertex_quality) vertex_quality.resize(nv);
+    if (has_vertex_uv) vertex_uv.resize(2 * nv);
+    if (has_face_color) face_color.resize(4 * nf, 255);
+    if (has_face_quality) face_quality.resize(nf);
+    if (has_material) material.resize(nf);
+    if (has_vertex_selected) vertex_selected.resize(nv);
+    if (has_face_selected) face_selected.resize(nf);
+    soup.face_sizes.reserve(nf);
+  }
 };
+
+//! A text body that is not one element per line: the runs give way to one pass.
+struct Irregular {};
 
 //! Context for error messages: which element, instance and property is being read.
 struct Place {
@@ -310,6 +351,22 @@ class AsciiSource {
  public:
   AsciiSource(std::string_view bytes, const Header& header, const std::string& name, const Place& place)
       : in_(bytes.substr(header.body), name), place_(place), line_offset_(header.body_line - 1) {}
+  //! A run of the body's lines, one element each: a value past its line, or a line with
+  //! values left after its element, throws Irregular.
+  AsciiSource(std::string_view run, const std::string& name, const Place& place)
+      : in_(run, name), place_(place), line_offset_(0), one_per_line_(true) {}
+
+  //! After each element.
+  void end_element() {
+    if (!one_per_line_) return;
+    if (!in_.at_line_end()) throw Irregular{};
+    in_.next_line();
+  }
+  //! What follows a run's elements: blank lines only (the last run: the end of the file).
+  void only_blank_lines() {
+    in_.skip_space();
+    if (!in_.at_end()) throw Irregular{};
+  }
 
   double number(PlyType t) {
     std::string_view token = next(t);
@@ -367,8 +424,11 @@ class AsciiSource {
 
  private:
   std::string_view next(PlyType t) {
-    std::string_view token = in_.token();
-    if (token.empty()) fail("file ends, expected " + std::string(type_name(t)) + " for " + place_.describe());
+    std::string_view token = one_per_line_ ? in_.line_token() : in_.token();
+    if (token.empty()) {
+      if (one_per_line_) throw Irregular{};
+      fail("file ends, expected " + std::string(type_name(t)) + " for " + place_.describe());
+    }
     return token;
   }
 
@@ -379,6 +439,7 @@ class AsciiSource {
   TextScanner in_;
   const Place& place_;
   std::size_t line_offset_;
+  bool one_per_line_ = false;
 };
 
 template <bool BigEndian>
@@ -434,6 +495,7 @@ class BinarySource {
   }
 
   void finish() {}  // bytes after the last element are padding some writers add
+  void end_element() {}
 
   [[noreturn]] void fail(const std::string& what) const { fail_at(p_, what); }
 
@@ -457,14 +519,23 @@ class BinarySource {
   const Place& place_;
 };
 
+//! Reads the body's elements [first, last), counted over every element with data, into
+//! `sink` (whose arrays start at its vertex and face bases).
 template <class Source>
-void read_body(Source& in, Header& header, Place& place, Sink& sink) {
+void read_body(Source& in, const Header& header, Place& place, Sink& sink, std::uint64_t first = 0,
+               std::uint64_t last = std::numeric_limits<std::uint64_t>::max()) {
   Soup& soup = sink.soup;
+  std::uint64_t before = 0;  // instances of the elements before e
   for (const PlyElement& e : header.elements) {
     place.element = &e;
     if (e.properties.empty()) continue;  // no data at all, whatever the count
-    for (std::uint64_t i = 0; i < e.count; ++i) {
+    const std::uint64_t begin = std::clamp(first, before, before + e.count) - before;
+    const std::uint64_t end = std::clamp(last, before, before + e.count) - before;
+    before += e.count;
+    const std::uint64_t base = e.kind == Kind::vertex ? sink.vertex_base : e.kind == Kind::face ? sink.face_base : 0;
+    for (std::uint64_t i = begin; i < end; ++i) {
       place.instance = i;
+      const std::uint64_t at = i - base;
       std::uint32_t face_size = 0;
       if (e.kind == Kind::face) sink.texcoord.clear();
       for (const PlyProperty& p : e.properties) {
@@ -496,22 +567,22 @@ void read_body(Source& in, Header& header, Place& place, Sink& sink) {
         if (e.kind == Kind::vertex) {
           switch (p.target) {
             case Target::position:
-              soup.positions[i][k] = static_cast<float>(v);
+              soup.positions[at][k] = static_cast<float>(v);
               break;
             case Target::normal:
-              sink.normals[3 * i + k] = static_cast<float>(v);
+              sink.normals[3 * at + k] = static_cast<float>(v);
               break;
             case Target::color:
-              sink.vertex_color[4 * i + k] = is_real(p.type) ? color_from_real(v) : color_from_integer(v);
+              sink.vertex_color[4 * at + k] = is_real(p.type) ? color_from_real(v) : color_from_integer(v);
               break;
             case Target::quality:
-              sink.vertex_quality[i] = static_cast<float>(v);
+              sink.vertex_quality[at] = static_cast<float>(v);
               break;
             case Target::uv:
-              sink.vertex_uv[2 * i + k] = static_cast<float>(v);
+              sink.vertex_uv[2 * at + k] = static_cast<float>(v);
               break;
             case Target::selected:
-              sink.vertex_selected[i] = v != 0;
+              sink.vertex_selected[at] = v != 0;
               break;
             default:
               break;
@@ -519,16 +590,16 @@ void read_body(Source& in, Header& header, Place& place, Sink& sink) {
         } else {
           switch (p.target) {
             case Target::color:
-              sink.face_color[4 * i + k] = is_real(p.type) ? color_from_real(v) : color_from_integer(v);
+              sink.face_color[4 * at + k] = is_real(p.type) ? color_from_real(v) : color_from_integer(v);
               break;
             case Target::quality:
-              sink.face_quality[i] = static_cast<float>(v);
+              sink.face_quality[at] = static_cast<float>(v);
               break;
             case Target::material:
-              sink.material[i] = static_cast<std::int32_t>(std::clamp(v, -2147483648.0, 2147483647.0));
+              sink.material[at] = static_cast<std::int32_t>(std::clamp(v, -2147483648.0, 2147483647.0));
               break;
             case Target::selected:
-              sink.face_selected[i] = v != 0;
+              sink.face_selected[at] = v != 0;
               break;
             default:
               break;
@@ -549,9 +620,125 @@ void read_body(Source& in, Header& header, Place& place, Sink& sink) {
           }
         }
       }
+      in.end_element();
     }
   }
-  in.finish();
+}
+
+//! The text body read in runs of about 1 MB of lines on all threads, each line one element:
+//! the arrays one pass would fill, in `sink`. False, with `sink` as it was, when the body is
+//! small, holds an element over several lines or several on one, or has an error: one pass
+//! then reads it (and names the error).
+bool read_text_in_runs(std::string_view bytes, const Header& header, const std::string& name, Sink& sink) {
+  const std::size_t run_bytes = testing::parallel_grain() ? testing::parallel_grain() : std::size_t(1) << 20;
+  const std::string_view body = bytes.substr(header.body);
+  if (body.size() < 2 * run_bytes) return false;
+  // The instances in body order, and where the vertices and the faces start among them.
+  std::uint64_t total = 0, first_vertex = 0, first_face = 0, nv = 0, nf = 0;
+  for (const PlyElement& e : header.elements) {
+    if (e.properties.empty()) {
+      if (e.count > 0) return false;
+      continue;
+    }
+    if (e.kind == Kind::vertex) first_vertex = total, nv = e.count;
+    if (e.kind == Kind::face) first_face = total, nf = e.count;
+    total += e.count;
+  }
+  std::vector<std::string_view> text;
+  for (std::size_t begin = 0; begin < body.size();) {
+    std::size_t end = body.find('\n', std::min(begin + run_bytes, body.size() - 1));
+    end = end == std::string_view::npos ? body.size() : end + 1;
+    text.push_back(body.substr(begin, end - begin));
+    begin = end;
+  }
+  // Lines before each run: one element each.
+  std::vector<std::uint64_t> first(text.size() + 1, 0);
+  parallel_for(
+      text.size(), 0,
+      [&](std::size_t begin, std::size_t end) {
+        for (std::size_t r = begin; r < end; ++r)
+          first[r + 1] = std::uint64_t(std::count(text[r].begin(), text[r].end(), '\n')) +
+                         (r + 1 == text.size() && text[r].back() != '\n');
+      },
+      1);
+  for (std::size_t r = 0; r < text.size(); ++r) first[r + 1] += first[r];
+  if (first.back() < total) return false;  // fewer lines than elements
+
+  struct Run {
+    Soup soup;
+    Sink sink{soup};
+    bool ok = true;
+  };
+  std::vector<std::unique_ptr<Run>> runs(text.size());
+  std::atomic<std::size_t> next{0};
+  parallel_for(
+      std::min<std::size_t>(runs.size(), resolve_thread_count(0)), 0,
+      [&](std::size_t, std::size_t) {
+        for (std::size_t r; (r = next.fetch_add(1)) < runs.size();) {
+          runs[r] = std::make_unique<Run>();
+          Run& run = *runs[r];
+          const std::uint64_t a = std::min(first[r], total), b = std::min(first[r + 1], total);
+          auto range = [&](std::uint64_t start, std::uint64_t n, std::uint64_t x) {
+            return std::clamp(x, start, start + n) - start;
+          };
+          Sink& s = run.sink;
+          s.has_normal = sink.has_normal, s.has_vertex_color = sink.has_vertex_color;
+          s.has_vertex_quality = sink.has_vertex_quality, s.has_vertex_uv = sink.has_vertex_uv;
+          s.has_face_color = sink.has_face_color, s.has_face_quality = sink.has_face_quality;
+          s.has_material = sink.has_material, s.has_texcoord = sink.has_texcoord;
+          s.has_vertex_selected = sink.has_vertex_selected, s.has_face_selected = sink.has_face_selected;
+          s.vertex_base = range(first_vertex, nv, a), s.face_base = range(first_face, nf, a);
+          s.size(range(first_vertex, nv, b) - s.vertex_base, range(first_face, nf, b) - s.face_base);
+          Place place;
+          AsciiSource in(text[r], name, place);
+          try {
+            read_body(in, header, place, s, a, b);
+            in.only_blank_lines();
+          } catch (const Irregular&) {
+            run.ok = false;
+          } catch (const Error&) {
+            run.ok = false;
+          }
+        }
+      },
+      1);
+  for (const auto& run : runs)
+    if (!run->ok) return false;
+
+  // Joined in order: vertex and face arrays at their bases, corners one after another.
+  std::vector<std::uint64_t> corners_before(runs.size() + 1, 0);
+  for (std::size_t r = 0; r < runs.size(); ++r)
+    corners_before[r + 1] = corners_before[r] + runs[r]->soup.corners.size();
+  Soup& soup = sink.soup;
+  soup.face_sizes.resize(nf);
+  soup.corners.resize(corners_before.back());
+  if (sink.has_texcoord) sink.corner_uv.resize(2 * corners_before.back());
+  parallel_for(
+      runs.size(), 0,
+      [&](std::size_t begin, std::size_t end) {
+        for (std::size_t r = begin; r < end; ++r) {
+          const Sink& s = runs[r]->sink;
+          const std::uint64_t v = s.vertex_base, f = s.face_base, c = corners_before[r];
+          auto put = [](const auto& from, auto& to, std::uint64_t at) {
+            if (!from.empty()) std::copy(from.begin(), from.end(), to.begin() + std::ptrdiff_t(at));
+          };
+          put(s.soup.positions, soup.positions, v);
+          put(s.normals, sink.normals, 3 * v);
+          put(s.vertex_color, sink.vertex_color, 4 * v);
+          put(s.vertex_quality, sink.vertex_quality, v);
+          put(s.vertex_uv, sink.vertex_uv, 2 * v);
+          put(s.vertex_selected, sink.vertex_selected, v);
+          put(s.soup.face_sizes, soup.face_sizes, f);
+          put(s.face_color, sink.face_color, 4 * f);
+          put(s.face_quality, sink.face_quality, f);
+          put(s.material, sink.material, f);
+          put(s.face_selected, sink.face_selected, f);
+          put(s.soup.corners, soup.corners, c);
+          put(s.corner_uv, sink.corner_uv, 2 * c);
+        }
+      },
+      1);
+  return true;
 }
 
 }  // namespace
@@ -564,38 +751,14 @@ Soup read_ply(std::string_view bytes, const std::string& name) {
 
   Soup soup;
   Sink sink(soup);
+  sink.take_targets(header);
   std::uint64_t nv = 0, nf = 0;
   for (const PlyElement& e : header.elements) {
-    for (const PlyProperty& p : e.properties) {
-      if (e.kind == Kind::vertex) {
-        sink.has_normal |= p.target == Target::normal;
-        sink.has_vertex_color |= p.target == Target::color;
-        sink.has_vertex_quality |= p.target == Target::quality;
-        sink.has_vertex_uv |= p.target == Target::uv;
-        sink.has_vertex_selected |= p.target == Target::selected;
-      } else if (e.kind == Kind::face) {
-        sink.has_face_color |= p.target == Target::color;
-        sink.has_face_quality |= p.target == Target::quality;
-        sink.has_material |= p.target == Target::material;
-        sink.has_texcoord |= p.target == Target::texcoord;
-        sink.has_face_selected |= p.target == Target::selected;
-      }
-    }
     if (e.kind == Kind::vertex) nv = e.count;
     if (e.kind == Kind::face) nf = e.count;
   }
   // check_counts() bounds these by the file size.
-  soup.positions.resize(nv);
-  if (sink.has_normal) sink.normals.resize(3 * nv);
-  if (sink.has_vertex_color) sink.vertex_color.resize(4 * nv, 255);
-  if (sink.has_vertex_quality) sink.vertex_quality.resize(nv);
-  if (sink.has_vertex_uv) sink.vertex_uv.resize(2 * nv);
-  if (sink.has_face_color) sink.face_color.resize(4 * nf, 255);
-  if (sink.has_face_quality) sink.face_quality.resize(nf);
-  if (sink.has_material) sink.material.resize(nf);
-  if (sink.has_vertex_selected) sink.vertex_selected.resize(nv);
-  if (sink.has_face_selected) sink.face_selected.resize(nf);
-  soup.face_sizes.reserve(nf);
+  sink.size(nv, nf);
   std::size_t index_bytes = 2;
   for (const PlyElement& e : header.elements)
     if (e.kind == Kind::face)
@@ -606,8 +769,10 @@ Soup read_ply(std::string_view bytes, const std::string& name) {
   Place place;
   switch (header.encoding) {
     case Encoding::ascii: {
+      if (read_text_in_runs(bytes, header, name, sink)) break;
       AsciiSource in(bytes, header, name, place);
       read_body(in, header, place, sink);
+      in.finish();
       break;
     }
     case Encoding::binary_little_endian: {

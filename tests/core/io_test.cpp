@@ -433,6 +433,44 @@ TEST(IoObj, RoundTrip) {
   EXPECT_EQ(vt_lines, 5u);
 }
 
+//! A soup, or the message of the error reading it gave.
+using ReadResult = std::variant<Soup, std::string>;
+
+template <class Reader>
+ReadResult read_result(Reader reader, const std::string& text) {
+  try {
+    return reader(text);
+  } catch (const Error& e) {
+    return std::string(e.what());
+  }
+}
+
+//! Reads each text whole, then in runs of 1 to 64 bytes on two threads: the same soup or the
+//! same error each time. Returns how many reads in runs split work across threads.
+template <class Reader>
+std::size_t expect_same_in_runs(const std::vector<std::string>& files, Reader reader) {
+  std::size_t split = 0;
+  for (const std::string& text : files) {
+    const ReadResult whole = read_result(reader, text);
+    for (std::size_t run_bytes : {1, 2, 3, 5, 8, 13, 21, 64}) {
+      set_thread_count(2);
+      testing::set_parallel_grain(run_bytes);
+      const std::size_t splits = testing::parallel_splits();
+      const ReadResult in_runs = read_result(reader, text);
+      split += testing::parallel_splits() > splits;
+      set_thread_count(0);
+      testing::set_parallel_grain(0);
+      EXPECT_EQ(whole.index(), in_runs.index()) << text << "\nruns of " << run_bytes << " bytes";
+      if (whole.index() != in_runs.index()) continue;
+      if (whole.index() == 0)
+        EXPECT_TRUE(std::get<Soup>(whole) == std::get<Soup>(in_runs)) << text << "\nruns of " << run_bytes << " bytes";
+      else
+        EXPECT_EQ(std::get<std::string>(whole), std::get<std::string>(in_runs)) << "runs of " << run_bytes << " bytes";
+    }
+  }
+  return split;
+}
+
 TEST(IoObj, RunsOfAnySizeReadAsTheWholeFile) {
   // The reader cuts a file into runs of lines, read on several threads and joined: every
   // run size gives the soup, or the error (line and message), of the file read whole.
@@ -452,30 +490,10 @@ TEST(IoObj, RunsOfAnySizeReadAsTheWholeFile) {
       "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nv 1 2 \\\n",
       "v 0 0 0\nv 1 0 0\nv 0 1 0\n\n\nf 1 2 3 junk/1/2/3\n",
   };
-  auto read = [](const std::string& text) -> std::variant<Soup, std::string> {
-    try {
-      return read_obj(text, "runs.obj");
-    } catch (const Error& e) {
-      return std::string(e.what());
-    }
-  };
-  for (const std::string& text : files) {
-    const auto whole = read(text);
-    for (std::size_t run_bytes : {1, 2, 3, 5, 8, 13, 21, 64}) {
-      set_thread_count(2);
-      testing::set_parallel_grain(run_bytes);
-      const auto in_runs = read(text);
-      set_thread_count(0);
-      testing::set_parallel_grain(0);
-      ASSERT_EQ(whole.index(), in_runs.index()) << text << "\nruns of " << run_bytes << " bytes";
-      if (whole.index() == 0)
-        EXPECT_TRUE(std::get<Soup>(whole) == std::get<Soup>(in_runs)) << text << "\nruns of " << run_bytes << " bytes";
-      else
-        EXPECT_EQ(std::get<std::string>(whole), std::get<std::string>(in_runs)) << "runs of " << run_bytes << " bytes";
-    }
-  }
+  auto read = [](const std::string& text) { return read_obj(text, "runs.obj"); };
+  EXPECT_GT(expect_same_in_runs(files, read), 0u);
   // What the first file holds, read whole.
-  const Soup s = std::get<Soup>(read(files[0]));
+  const Soup s = read(files[0]);
   EXPECT_EQ(s.n_faces(), 5u);
   EXPECT_EQ(values<std::int32_t>(channel(s, "material", Domain::face)), (std::vector<std::int32_t>{-1, 0, 0, 1, 0}));
   EXPECT_EQ(s.corners, (std::vector<std::uint32_t>{0, 1, 2, 0, 1, 3, 1, 3, 2, 0, 1, 2, 1, 3, 2}));
@@ -704,6 +722,39 @@ TEST(IoPly, RoundTrip) {
   big.add_face(ring);
   expect_same(read_ply(write_ply(big, true), "big.ply"), big);
   expect_same(read_ply(write_ply(big, false), "big.ply"), big);
+}
+
+TEST(IoPly, TextInRunsReadsAsTheWholeFile) {
+  // A text body of one element a line is read in runs of lines on several threads; any
+  // other body, or an error, is read in one pass. Every run size gives the soup, or the
+  // error, of the file read whole.
+  const std::string head =
+      "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+      "property uchar red\nproperty uchar green\nproperty uchar blue\nelement face 3\n"
+      "property list uchar int vertex_indices\nproperty list uchar float texcoord\nproperty int material_index\n"
+      "element note 2\nproperty float weight\nend_header\n";
+  const std::string vertices = "0 0 0 255 0 0\n1 0 0 0 255 0\n0 1 0 0 0 255\n1 1 0.5 9 9 9\n";
+  const std::vector<std::string> files = {
+      head + vertices + "3 0 1 2 6 0 0 1 0 0 1 7\n3 1 3 2 0 -1\n4 0 1 3 2 8 0 0 1 0 1 1 0 1 2\n0.5\n0.25\n",
+      head + vertices + "3 0 1 2 6 0 0 1 0 0 1 7\n3 1 3 2 0 -1\n4 0 1 3 2 8 0 0 1 0 1 1 0 1 2\n0.5\n0.25",
+      head + vertices + "3 0 1 2 6 0 0 1 0 0 1 7\n3 1 3 2 0 -1\n4 0 1 3 2 8 0 0 1 0 1 1 0 1 2\n0.5\n0.25\n\n\n",
+      // Elements over several lines, several on one, blank lines between: one pass.
+      head +
+          "0 0 0 255 0 0 1 0 0\n0 255 0\n0 1 0 0 0 255\n1 1 0.5 9 9 9\n3 0 1 2 6 0 0 1 0 0 1 7\n3 1 3 2 0 -1\n"
+          "4 0 1 3 2 8 0 0 1 0 1 1 0 1 2\n0.5 0.25\n",
+      head + vertices + "\n3 0 1 2 6 0 0 1 0 0 1 7\n3 1 3 2 0 -1\n4 0 1 3 2 8 0 0 1 0 1 1 0 1 2\n0.5\n0.25\n",
+      // Errors: truncated, too many values, a bad number, a bad index, a texcoord mismatch.
+      head + vertices + "3 0 1 2 6 0 0 1 0 0 1 7\n3 1 3 2 0 -1\n",
+      head + vertices + "3 0 1 2 6 0 0 1 0 0 1 7\n3 1 3 2 0 -1\n4 0 1 3 2 8 0 0 1 0 1 1 0 1 2\n0.5\n0.25\n7\n",
+      head + vertices + "3 0 1 2 6 0 0 1 0 0 1 7\n3 1 3 x 0 -1\n4 0 1 3 2 8 0 0 1 0 1 1 0 1 2\n0.5\n0.25\n",
+      head + vertices + "3 0 1 9 6 0 0 1 0 0 1 7\n3 1 3 2 0 -1\n4 0 1 3 2 8 0 0 1 0 1 1 0 1 2\n0.5\n0.25\n",
+      head + vertices + "3 0 1 2 4 0 0 1 0 7\n3 1 3 2 0 -1\n4 0 1 3 2 8 0 0 1 0 1 1 0 1 2\n0.5\n0.25\n",
+  };
+  auto read = [](const std::string& text) { return read_ply(text, "runs.ply"); };
+  EXPECT_GT(expect_same_in_runs(files, read), 0u);
+  const Soup s = read(files[0]);
+  EXPECT_EQ(s.corners, (std::vector<std::uint32_t>{0, 1, 2, 1, 3, 2, 0, 1, 3, 2}));
+  EXPECT_EQ(values<std::int32_t>(channel(s, "material", Domain::face)), (std::vector<std::int32_t>{7, -1, 2}));
 }
 
 TEST(IoPly, HeaderErrors) {

@@ -8,13 +8,16 @@
 #include <cstdlib>
 #include <cstring>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "../core/defect_counts.h"
 #include "hedge/build.h"
 #include "hedge/error.h"
 #include "hedge/soup.h"
+#include "hedge/threads.h"
 #include "hedge/validate.h"
+#include "parallel.h"
 
 namespace hedge_fuzz {
 
@@ -66,8 +69,9 @@ inline std::string describe_difference(const hedge::Soup& a, const hedge::Soup& 
   for (std::size_t i = 0; i < a.positions.size(); ++i)
     if (std::memcmp(&a.positions[i], &b.positions[i], sizeof(a.positions[i])) != 0)
       return "position of vertex " + std::to_string(i);
-  if (a.face_sizes != b.face_sizes) return "face sizes (" + std::to_string(a.face_sizes.size()) + " vs " +
-                                           std::to_string(b.face_sizes.size()) + " faces)";
+  if (a.face_sizes != b.face_sizes)
+    return "face sizes (" + std::to_string(a.face_sizes.size()) + " vs " + std::to_string(b.face_sizes.size()) +
+           " faces)";
   if (a.corners != b.corners) return "corner indices";
   if (a.channels.size() != b.channels.size())
     return "channel count " + std::to_string(a.channels.size()) + " vs " + std::to_string(b.channels.size());
@@ -124,6 +128,39 @@ inline void check_build_round_trip(const hedge::Soup& soup, bool with_input = fa
   std::string diff = describe_difference(back, expected);
   if (!diff.empty()) fail("extract(build(soup)) differs from the soup: " + diff);
   if (with_input) check_extract_with_input(built, soup, expected);
+}
+
+//! Reads `bytes` with `read` whole, then in runs of a few bytes on two threads (the OBJ and
+//! PLY text readers cut big files into runs read side by side): the same soup, or the same
+//! error, must come back; then what was read must build and round-trip.
+template <class Read>
+void check_reader(std::string_view bytes, Read read) {
+  struct Result {
+    hedge::Soup soup;
+    std::string error;
+    bool failed = false;
+  };
+  auto attempt = [&] {
+    Result r;
+    try {
+      r.soup = read(bytes);
+    } catch (const hedge::Error& e) {
+      r.failed = true;
+      r.error = e.what();
+    }
+    return r;
+  };
+  const Result whole = attempt();
+  const std::size_t run_bytes = 1 + bytes.size() % 7;
+  hedge::set_thread_count(2);
+  hedge::testing::set_parallel_grain(run_bytes);
+  const Result in_runs = attempt();
+  hedge::set_thread_count(0);
+  hedge::testing::set_parallel_grain(0);
+  if (whole.failed != in_runs.failed || whole.error != in_runs.error || !(whole.soup == in_runs.soup))
+    fail("read in runs of " + std::to_string(run_bytes) + " bytes differs from the whole file: '" +
+         (whole.failed ? whole.error : "a soup") + "' against '" + (in_runs.failed ? in_runs.error : "a soup") + "'");
+  if (!whole.failed) check_build_round_trip(whole.soup);
 }
 
 inline std::string describe(const hedge::test::DefectCounts& d) {
