@@ -627,12 +627,13 @@ void read_body(Source& in, const Header& header, Place& place, Sink& sink, std::
 
 //! The text body read in runs of about 1 MB of lines on all threads, each line one element:
 //! the arrays one pass would fill, in `sink`. False, with `sink` as it was, when the body is
-//! small, holds an element over several lines or several on one, or has an error: one pass
-//! then reads it (and names the error).
+//! small, there is one thread, or the body holds an element over several lines or several on
+//! one, or has an error: one pass then reads it (and names the error).
 bool read_text_in_runs(std::string_view bytes, const Header& header, const std::string& name, Sink& sink) {
   const std::size_t run_bytes = testing::parallel_grain() ? testing::parallel_grain() : std::size_t(1) << 20;
   const std::string_view body = bytes.substr(header.body);
-  if (body.size() < 2 * run_bytes) return false;
+  // On one thread the runs' joining would only add to one pass.
+  if (body.size() < 2 * run_bytes || resolve_thread_count(0) < 2) return false;
   // The instances in body order, and where the vertices and the faces start among them.
   std::uint64_t total = 0, first_vertex = 0, first_face = 0, nv = 0, nf = 0;
   for (const PlyElement& e : header.elements) {
