@@ -64,7 +64,10 @@ void weld(const std::vector<Point>& raw, Soup& soup) {
   for (std::size_t i = 0; i < raw.size(); ++i) {
     Key k = key_of(raw[i]);
     std::size_t slot = hash(k) & mask;
-    while (table[slot] != kEmpty && keys[table[slot]] != k) slot = (slot + 1) & mask;
+    auto other = [&](std::uint32_t id) {  // element by element: std::array's == calls memcmp
+      return keys[id][0] != k[0] || keys[id][1] != k[1] || keys[id][2] != k[2];
+    };
+    while (table[slot] != kEmpty && other(table[slot])) slot = (slot + 1) & mask;
     if (table[slot] == kEmpty) {
       table[slot] = static_cast<std::uint32_t>(keys.size());
       keys.push_back(k);
