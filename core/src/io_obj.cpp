@@ -311,7 +311,7 @@ class RunJoin {
     float* color = colors ? soup.add_channel("color", Domain::vertex, ScalarType::f32, 4).as<float>() : nullptr;
     std::int32_t* material =
         seen_material_ ? soup.add_channel("material", Domain::face, ScalarType::i32, 1).as<std::int32_t>() : nullptr;
-    each_run([&](const ObjRun& run, const Start& at) {
+    each_run([&](ObjRun& run, const Start& at) {
       std::copy(run.positions.begin(), run.positions.end(), soup.positions.begin() + std::ptrdiff_t(at.vertices));
       std::copy(run.face_sizes.begin(), run.face_sizes.end(), soup.face_sizes.begin() + std::ptrdiff_t(at.faces));
       std::copy(run.corners.begin(), run.corners.end(), soup.corners.begin() + std::ptrdiff_t(at.corners));
@@ -331,6 +331,9 @@ class RunJoin {
         for (std::size_t f = inherited; f < run.face_sizes.size(); ++f)
           out[f] = at.material_ids[std::size_t(run.materials[f - inherited])];
       }
+      // Copied: the run's memory goes now, not with the soup's peak (its corners' texture
+      // coordinate and normal indices serve the gathers below).
+      release(run.positions, run.face_sizes, run.corners, run.texcoords, run.normals, run.colors, run.materials);
     });
     if (all_vt && corners_ > 0)
       gather(soup.add_channel("uv", Domain::corner, ScalarType::f32, 2), texcoords, 2, &ObjRun::corner_vt);
@@ -381,6 +384,11 @@ class RunJoin {
                         " is out of range: the file defines " + std::to_string(count));
   }
 
+  template <class... Vectors>
+  static void release(Vectors&... v) {
+    (Vectors().swap(v), ...);
+  }
+
   template <class Fn>
   void each_run(Fn&& fn) {
     parallel_for(
@@ -393,7 +401,7 @@ class RunJoin {
 
   void gather(Channel& c, const std::vector<float>& values, int n, std::vector<std::uint32_t> ObjRun::*of_corner) {
     float* out = c.as<float>();
-    each_run([&](const ObjRun& run, const Start& at) {
+    each_run([&](ObjRun& run, const Start& at) {
       const std::vector<std::uint32_t>& index = run.*of_corner;
       for (std::size_t i = 0; i < index.size(); ++i)
         std::memcpy(out + n * (at.corners + i), &values[std::size_t(n) * index[i]], n * sizeof(float));
