@@ -2,6 +2,7 @@
 // that name the place, a text scanner that counts lines, exact number parsing and printing.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <charconv>
@@ -78,6 +79,31 @@ struct Pieces {
   std::vector<std::string> parts;
   std::string joined() &&;
 };
+
+//! Thrown by a reader reading a run of a file when the run is not what the parallel reading
+//! assumed (PLY text: one element a line): the file is then read in one pass.
+struct Irregular {};
+
+//! Cuts `text` into runs of about `bytes` each, every run but the last ending with a line
+//! break at which `may_cut(text, i)` (i: the break's index) allows a cut.
+template <class MayCut>
+std::vector<std::string_view> cut_into_runs(std::string_view text, std::size_t bytes, MayCut may_cut) {
+  std::vector<std::string_view> runs;
+  for (std::size_t begin = 0; begin < text.size();) {
+    std::size_t end = std::min(begin + bytes, text.size());
+    for (;;) {
+      end = text.find('\n', end);
+      if (end == std::string_view::npos) {
+        end = text.size();
+        break;
+      }
+      if (may_cut(text, end++)) break;
+    }
+    runs.push_back(text.substr(begin, end - begin));
+    begin = end;
+  }
+  return runs;
+}
 
 Pieces format_off(const Soup& soup);
 Pieces format_obj(const Soup& soup);

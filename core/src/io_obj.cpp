@@ -238,34 +238,6 @@ class RunReader {
   bool seen_material_ = false;
 };
 
-//! Cuts the file into runs of whole lines, about `bytes` each: after a line break that no
-//! backslash continues.
-std::vector<std::string_view> cut_into_runs(std::string_view text, std::size_t bytes) {
-  std::vector<std::string_view> runs;
-  std::size_t begin = 0;
-  while (begin < text.size()) {
-    std::size_t end = begin + bytes;
-    for (;;) {
-      if (end >= text.size()) {
-        end = text.size();
-        break;
-      }
-      end = text.find('\n', end);
-      if (end == std::string_view::npos) {
-        end = text.size();
-        break;
-      }
-      std::size_t before = end;
-      if (before > begin && text[before - 1] == '\r') --before;
-      ++end;
-      if (before == begin || text[before - 1] != '\\') break;
-    }
-    runs.push_back(text.substr(begin, end - begin));
-    begin = end;
-  }
-  return runs;
-}
-
 //! Joins the runs in order: indices settled, materials numbered by first use in the file,
 //! errors reported in the order the file has them.
 class RunJoin {
@@ -477,7 +449,11 @@ Soup read_obj(std::string_view bytes, const std::string& name) {
   // Runs of about 1 MB, read on all threads, each numbering its lines from 1 (the join adds
   // the lines before it).
   const std::size_t run_bytes = testing::parallel_grain() ? testing::parallel_grain() : std::size_t(1) << 20;
-  const std::vector<std::string_view> text = cut_into_runs(bytes, run_bytes);
+  // Cut after line breaks that no backslash continues.
+  const std::vector<std::string_view> text = cut_into_runs(bytes, run_bytes, [](std::string_view t, std::size_t i) {
+    if (i > 0 && t[i - 1] == '\r') --i;
+    return i == 0 || t[i - 1] != '\\';
+  });
   std::vector<ObjRun> runs(text.size());
   // Each thread takes the next run left: a run of faces takes longer than one of vertices.
   std::atomic<std::size_t> next{0};

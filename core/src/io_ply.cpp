@@ -332,9 +332,6 @@ struct Sink {
   }
 };
 
-//! A text body that is not one element per line: the runs give way to one pass.
-struct Irregular {};
-
 //! Context for error messages: which element, instance and property is being read.
 struct Place {
   const PlyElement* element = nullptr;
@@ -645,13 +642,8 @@ bool read_text_in_runs(std::string_view bytes, const Header& header, const std::
     if (e.kind == Kind::face) first_face = total, nf = e.count;
     total += e.count;
   }
-  std::vector<std::string_view> text;
-  for (std::size_t begin = 0; begin < body.size();) {
-    std::size_t end = body.find('\n', std::min(begin + run_bytes, body.size() - 1));
-    end = end == std::string_view::npos ? body.size() : end + 1;
-    text.push_back(body.substr(begin, end - begin));
-    begin = end;
-  }
+  const std::vector<std::string_view> text =
+      cut_into_runs(body, run_bytes, [](std::string_view, std::size_t) { return true; });
   // Lines before each run: one element each.
   std::vector<std::uint64_t> first(text.size() + 1, 0);
   parallel_for(

@@ -1,6 +1,7 @@
 // STL files, ASCII and binary. STL stores each triangle with its own three positions;
 // the reader welds equal positions into shared vertices, the writer fans polygons.
 #include <algorithm>
+#include <atomic>
 #include <cctype>
 #include <cstdint>
 #include <cstring>
@@ -91,8 +92,13 @@ Soup read_binary(std::string_view bytes, std::uint32_t triangles, const std::str
   return soup;
 }
 
-Soup read_ascii(std::string_view bytes, const std::string& name) {
-  TextScanner in(bytes, name);
+//! Reads facets into `raw` and `sizes`. The whole file (`first` and `last`), or a run of
+//! it: a run after the first starts at a facet, and one before the last may end after any
+//! facet; where the run's end would be an error to one pass, or a run ends after 'endsolid',
+//! it throws Irregular, and the file is read in one pass.
+void read_ascii_facets(std::string_view text, const std::string& name, bool first, bool last, std::vector<Point>& raw,
+                       std::vector<std::uint32_t>& sizes) {
+  TextScanner in(text, name);
   auto expect = [&](const char* keyword) {
     std::string_view t = in.token();
     if (!iequal(t, keyword)) {
@@ -102,23 +108,27 @@ Soup read_ascii(std::string_view bytes, const std::string& name) {
       in.fail_expected(quoted, t);
     }
   };
-  std::vector<Point> raw;
-  Soup soup;
-  expect("solid");
-  in.next_line();  // the solid's name
+  if (first) {
+    expect("solid");
+    in.next_line();  // the solid's name
+  }
   for (;;) {
     std::string_view t = in.token();
+    if (!last && t.empty() && in.at_end()) break;
     if (iequal(t, "endsolid")) {
       in.next_line();
       in.skip_space();
-      if (in.at_end()) break;
+      if (in.at_end()) {
+        if (!last) throw Irregular{};  // the next run's facet would follow it
+        break;
+      }
       t = in.token();
       if (!iequal(t, "solid")) in.fail_expected("'solid' or the end of the file", t);
       in.next_line();
       continue;
     }
     if (!iequal(t, "facet")) in.fail_expected("'facet' or 'endsolid'", t);
-    const std::size_t facet = soup.face_sizes.size();
+    const std::size_t facet = sizes.size();
     expect("normal");
     for (int k = 0; k < 3; ++k) {
       float v;
@@ -143,9 +153,66 @@ Soup read_ascii(std::string_view bytes, const std::string& name) {
     if (corners < 3)
       in.fail("facet " + std::to_string(facet) + " has " + plural(corners, "vertex", "vertices") + ", expected 3");
     expect("endfacet");
-    soup.face_sizes.push_back(corners);
+    sizes.push_back(corners);
   }
   if (raw.size() > 0xffffffffu) in.fail("more corners than hedge can index");
+}
+
+//! Big files are read in runs of about 1 MB, each starting at a facet, on all threads, and
+//! joined in order; a run that fails or finds something one pass would read otherwise hands
+//! the file to one pass, which names the error.
+Soup read_ascii(std::string_view bytes, const std::string& name) {
+  std::vector<Point> raw;
+  Soup soup;
+  const std::size_t run_bytes = testing::parallel_grain() ? testing::parallel_grain() : std::size_t(1) << 20;
+  bool in_runs = bytes.size() >= 2 * run_bytes && resolve_thread_count(0) >= 2;
+  if (in_runs) {
+    const std::vector<std::string_view> text =
+        cut_into_runs(bytes, run_bytes, [](std::string_view t, std::size_t i) {  // before a line 'facet ...'
+          std::size_t k = i + 1;
+          while (k < t.size() && (t[k] == ' ' || t[k] == '\t' || t[k] == '\r')) ++k;
+          return k + 5 <= t.size() && iequal(t.substr(k, 5), "facet") &&
+                 (k + 5 == t.size() || std::isspace(static_cast<unsigned char>(t[k + 5])));
+        });
+    struct Run {
+      std::vector<Point> raw;
+      std::vector<std::uint32_t> sizes;
+      bool ok = true;
+    };
+    std::vector<Run> runs(text.size());
+    std::atomic<std::size_t> next{0};
+    parallel_for(
+        std::min<std::size_t>(runs.size(), resolve_thread_count(0)), 0,
+        [&](std::size_t, std::size_t) {
+          for (std::size_t r; (r = next.fetch_add(1)) < runs.size();) try {
+              read_ascii_facets(text[r], name, r == 0, r + 1 == runs.size(), runs[r].raw, runs[r].sizes);
+            } catch (const Irregular&) {
+              runs[r].ok = false;
+            } catch (const Error&) {
+              runs[r].ok = false;
+            }
+        },
+        1);
+    std::size_t corners = 0;
+    for (const Run& run : runs) {
+      in_runs = in_runs && run.ok;
+      corners += run.raw.size();
+    }
+    if (corners > 0xffffffffu) in_runs = false;
+    if (in_runs) {
+      raw.reserve(corners);
+      for (Run& run : runs) {
+        raw.insert(raw.end(), run.raw.begin(), run.raw.end());
+        soup.face_sizes.insert(soup.face_sizes.end(), run.sizes.begin(), run.sizes.end());
+        std::vector<Point>().swap(run.raw);
+      }
+    }
+  }
+  if (!in_runs) {
+    raw.clear();
+    soup.face_sizes.clear();
+    read_ascii_facets(bytes, name, true, true, raw, soup.face_sizes);
+  }
   weld(raw, soup);
   check_soup(soup, name);
   return soup;

@@ -930,6 +930,35 @@ TEST(IoStl, Ascii) {
   EXPECT_EQ(s.corners, (std::vector<std::uint32_t>{0, 1, 2, 0, 2, 3, 0, 3, 4}));
 }
 
+TEST(IoStl, AsciiInRunsReadsAsTheWholeFile) {
+  // Text STL is read in runs starting at a facet on several threads; a run that fails, or
+  // ends where one pass would read on, hands the file to one pass. Every run size gives the
+  // soup, or the error, of the file read whole.
+  auto facet = [](int i, int corners = 3) {
+    std::string t = "  facet normal 0 0 1\n    outer loop\n";
+    for (int c = 0; c < corners; ++c)
+      t += "      vertex " + std::to_string(i + c % 2) + " " + std::to_string(c) + " " + std::to_string(i % 3) + "\n";
+    return t + "    endloop\n  endfacet\n";
+  };
+  std::string facets;
+  for (int i = 0; i < 6; ++i) facets += facet(i, i == 4 ? 4 : 3);
+  const std::vector<std::string> files = {
+      "solid a\n" + facets + "endsolid a\n",
+      "solid a\n" + facets + "endsolid a\nsolid b\n" + facet(7) + "endsolid b\n",
+      "SOLID a\r\n" + facets + "ENDSOLID\r\n\r\n",
+      "solid a\n" + facets + "endsolid a\n" + facet(9),
+      "solid a\n" + facets + "endsolid a\n" + facet(9) + "endsolid a\n",
+      "solid a\n" + facets,
+      "solid a\n" + facets + facet(8, 2) + "endsolid a\n",
+      "solid a\n" + facets + "  facet normal 0 0 x\n" + facets + "endsolid a\n",
+      "solid a\n" + facets + "endsolid a\nsolid\n",
+      "solid a\n" + facets + "endsolid a\njunk\n",
+  };
+  auto read = [](const std::string& text) { return read_stl(text, "runs.stl"); };
+  EXPECT_GT(expect_same_in_runs(files, read), 0u);
+  EXPECT_EQ(read(files[1]).n_faces(), 7u);
+}
+
 TEST(IoStl, BinaryHeaderStartingWithSolid) {
   Soup s = read_stl(binary_stl(cube_triangles(), "solid but binary"), "s.stl");
   EXPECT_EQ(s.n_faces(), 12u);
