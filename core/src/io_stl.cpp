@@ -281,37 +281,27 @@ Pieces io_detail::format_stl(const Soup& soup, bool binary) {
   }
   const std::vector<std::size_t> offsets = soup.face_offsets();
   append_elements(pieces, out, soup.n_faces(), [&](std::string& text, std::size_t f) {
-    auto vertex = [&](const Point& p) {
+    // Three floats: little-endian bytes, or text after `keyword`, ending with `after`.
+    auto three = [&](const char* keyword, const auto& v, const char* after) {
       if (binary) {
-        for (int k = 0; k < 3; ++k) append_le(text, p[k]);
-      } else {
-        text += "      vertex";
-        for (int k = 0; k < 3; ++k) {
-          text += ' ';
-          append_number(text, p[k]);
-        }
-        text += '\n';
+        for (int k = 0; k < 3; ++k) append_le(text, static_cast<float>(v[k]));
+        return;
       }
+      text += keyword;
+      for (int k = 0; k < 3; ++k) {
+        text += ' ';
+        append_number(text, static_cast<float>(v[k]));
+      }
+      text += after;
     };
     const std::uint32_t* c = soup.corners.data() + offsets[f];
     for (std::uint32_t k = 1; k + 1 < soup.face_sizes[f]; ++k) {
       const Point& a = soup.positions[c[0]];
       const Point& b = soup.positions[c[k]];
       const Point& d = soup.positions[c[k + 1]];
-      Vec3f n = to_float(normalize(cross(to_double(b) - to_double(a), to_double(d) - to_double(a))));
-      if (binary) {
-        for (int i = 0; i < 3; ++i) append_le(text, n[i]);
-      } else {
-        text += "  facet normal";
-        for (int i = 0; i < 3; ++i) {
-          text += ' ';
-          append_number(text, n[i]);
-        }
-        text += "\n    outer loop\n";
-      }
-      vertex(a);
-      vertex(b);
-      vertex(d);
+      const Vec3f n = to_float(normalize(cross(to_double(b) - to_double(a), to_double(d) - to_double(a))));
+      three("  facet normal", n, "\n    outer loop\n");
+      for (const Point* p : {&a, &b, &d}) three("      vertex", *p, "\n");
       if (binary)
         append_le(text, std::uint16_t{0});
       else
