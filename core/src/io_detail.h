@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <bit>
 #include <charconv>
 #include <cstddef>
@@ -81,8 +82,25 @@ struct Pieces {
 };
 
 //! Thrown by a reader reading a run of a file when the run is not what the parallel reading
-//! assumed (PLY text: one element a line): the file is then read in one pass.
+//! assumed (PLY text: one element a line; STL text: runs end after a facet): the file is then
+//! read in one pass.
 struct Irregular {};
+
+//! The bytes of text a reader reads as one run (tests make runs of a few bytes).
+inline std::size_t run_bytes() { return testing::parallel_grain() ? testing::parallel_grain() : std::size_t(1) << 20; }
+
+//! read(r) for every run r in [0, n), each thread taking the next run left: runs of faces
+//! take longer than runs of vertices.
+template <class Read>
+void read_runs(std::size_t n, Read&& read) {
+  std::atomic<std::size_t> next{0};
+  parallel_for(
+      std::min<std::size_t>(n, resolve_thread_count(0)), 0,
+      [&](std::size_t, std::size_t) {
+        for (std::size_t r; (r = next.fetch_add(1)) < n;) read(r);
+      },
+      1);
+}
 
 //! Cuts `text` into runs of about `bytes` each, every run but the last ending with a line
 //! break at which `may_cut(text, i)` (i: the break's index) allows a cut.

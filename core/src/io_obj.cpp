@@ -2,7 +2,6 @@
 // coordinates and normals, polygons with absolute or relative indices, usemtl as a material id.
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <cstdint>
 #include <cstring>
 #include <string>
@@ -448,22 +447,13 @@ class Dedup {
 Soup read_obj(std::string_view bytes, const std::string& name) {
   // Runs of about 1 MB, read on all threads, each numbering its lines from 1 (the join adds
   // the lines before it).
-  const std::size_t run_bytes = testing::parallel_grain() ? testing::parallel_grain() : std::size_t(1) << 20;
   // Cut after line breaks that no backslash continues.
-  const std::vector<std::string_view> text = cut_into_runs(bytes, run_bytes, [](std::string_view t, std::size_t i) {
+  const std::vector<std::string_view> text = cut_into_runs(bytes, run_bytes(), [](std::string_view t, std::size_t i) {
     if (i > 0 && t[i - 1] == '\r') --i;
     return i == 0 || t[i - 1] != '\\';
   });
   std::vector<ObjRun> runs(text.size());
-  // Each thread takes the next run left: a run of faces takes longer than one of vertices.
-  std::atomic<std::size_t> next{0};
-  parallel_for(
-      std::min<std::size_t>(runs.size(), resolve_thread_count(0)), 0,
-      [&](std::size_t, std::size_t) {
-        for (std::size_t r; (r = next.fetch_add(1)) < runs.size();)
-          runs[r].lines = RunReader(text[r], name, 1, runs[r]).read();
-      },
-      1);
+  read_runs(runs.size(), [&](std::size_t r) { runs[r].lines = RunReader(text[r], name, 1, runs[r]).read(); });
   return RunJoin(runs, text, name).join();
 }
 

@@ -3,7 +3,6 @@
 // quality/material, per-corner uv (MeshLab's texcoord list), and a vertex or face "selected"
 // (any scalar, non-zero when selected; hedge's own convention); anything else is skipped.
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -627,10 +626,9 @@ void read_body(Source& in, const Header& header, Place& place, Sink& sink, std::
 //! small, there is one thread, or the body holds an element over several lines or several on
 //! one, or has an error: one pass then reads it (and names the error).
 bool read_text_in_runs(std::string_view bytes, const Header& header, const std::string& name, Sink& sink) {
-  const std::size_t run_bytes = testing::parallel_grain() ? testing::parallel_grain() : std::size_t(1) << 20;
   const std::string_view body = bytes.substr(header.body);
   // On one thread the runs' joining would only add to one pass.
-  if (body.size() < 2 * run_bytes || resolve_thread_count(0) < 2) return false;
+  if (body.size() < 2 * run_bytes() || resolve_thread_count(0) < 2) return false;
   // The instances in body order, and where the vertices and the faces start among them.
   std::uint64_t total = 0, first_vertex = 0, first_face = 0, nv = 0, nf = 0;
   for (const PlyElement& e : header.elements) {
@@ -643,7 +641,7 @@ bool read_text_in_runs(std::string_view bytes, const Header& header, const std::
     total += e.count;
   }
   const std::vector<std::string_view> text =
-      cut_into_runs(body, run_bytes, [](std::string_view, std::size_t) { return true; });
+      cut_into_runs(body, run_bytes(), [](std::string_view, std::size_t) { return true; });
   // Lines before each run: one element each.
   std::vector<std::uint64_t> first(text.size() + 1, 0);
   parallel_for(
@@ -663,38 +661,28 @@ bool read_text_in_runs(std::string_view bytes, const Header& header, const std::
     bool ok = true;
   };
   std::vector<std::unique_ptr<Run>> runs(text.size());
-  std::atomic<std::size_t> next{0};
-  parallel_for(
-      std::min<std::size_t>(runs.size(), resolve_thread_count(0)), 0,
-      [&](std::size_t, std::size_t) {
-        for (std::size_t r; (r = next.fetch_add(1)) < runs.size();) {
-          runs[r] = std::make_unique<Run>();
-          Run& run = *runs[r];
-          const std::uint64_t a = std::min(first[r], total), b = std::min(first[r + 1], total);
-          auto range = [&](std::uint64_t start, std::uint64_t n, std::uint64_t x) {
-            return std::clamp(x, start, start + n) - start;
-          };
-          Sink& s = run.sink;
-          s.has_normal = sink.has_normal, s.has_vertex_color = sink.has_vertex_color;
-          s.has_vertex_quality = sink.has_vertex_quality, s.has_vertex_uv = sink.has_vertex_uv;
-          s.has_face_color = sink.has_face_color, s.has_face_quality = sink.has_face_quality;
-          s.has_material = sink.has_material, s.has_texcoord = sink.has_texcoord;
-          s.has_vertex_selected = sink.has_vertex_selected, s.has_face_selected = sink.has_face_selected;
-          s.vertex_base = range(first_vertex, nv, a), s.face_base = range(first_face, nf, a);
-          s.size(range(first_vertex, nv, b) - s.vertex_base, range(first_face, nf, b) - s.face_base);
-          Place place;
-          AsciiSource in(text[r], name, place);
-          try {
-            read_body(in, header, place, s, a, b);
-            in.only_blank_lines();
-          } catch (const Irregular&) {
-            run.ok = false;
-          } catch (const Error&) {
-            run.ok = false;
-          }
-        }
-      },
-      1);
+  read_runs(runs.size(), [&](std::size_t r) {
+    runs[r] = std::make_unique<Run>();
+    Run& run = *runs[r];
+    const std::uint64_t a = std::min(first[r], total), b = std::min(first[r + 1], total);
+    auto range = [&](std::uint64_t start, std::uint64_t n, std::uint64_t x) {
+      return std::clamp(x, start, start + n) - start;
+    };
+    Sink& s = run.sink;
+    s.take_targets(header);
+    s.vertex_base = range(first_vertex, nv, a), s.face_base = range(first_face, nf, a);
+    s.size(range(first_vertex, nv, b) - s.vertex_base, range(first_face, nf, b) - s.face_base);
+    Place place;
+    AsciiSource in(text[r], name, place);
+    try {
+      read_body(in, header, place, s, a, b);
+      in.only_blank_lines();
+    } catch (const Irregular&) {
+      run.ok = false;
+    } catch (const Error&) {
+      run.ok = false;
+    }
+  });
   for (const auto& run : runs)
     if (!run->ok) return false;
 

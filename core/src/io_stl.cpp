@@ -1,7 +1,6 @@
 // STL files, ASCII and binary. STL stores each triangle with its own three positions;
 // the reader welds equal positions into shared vertices, the writer fans polygons.
 #include <algorithm>
-#include <atomic>
 #include <cctype>
 #include <cstdint>
 #include <cstring>
@@ -164,11 +163,10 @@ void read_ascii_facets(std::string_view text, const std::string& name, bool firs
 Soup read_ascii(std::string_view bytes, const std::string& name) {
   std::vector<Point> raw;
   Soup soup;
-  const std::size_t run_bytes = testing::parallel_grain() ? testing::parallel_grain() : std::size_t(1) << 20;
-  bool in_runs = bytes.size() >= 2 * run_bytes && resolve_thread_count(0) >= 2;
+  bool in_runs = bytes.size() >= 2 * run_bytes() && resolve_thread_count(0) >= 2;
   if (in_runs) {
     const std::vector<std::string_view> text =
-        cut_into_runs(bytes, run_bytes, [](std::string_view t, std::size_t i) {  // before a line 'facet ...'
+        cut_into_runs(bytes, run_bytes(), [](std::string_view t, std::size_t i) {  // before a line 'facet ...'
           std::size_t k = i + 1;
           while (k < t.size() && (t[k] == ' ' || t[k] == '\t' || t[k] == '\r')) ++k;
           return k + 5 <= t.size() && iequal(t.substr(k, 5), "facet") &&
@@ -180,19 +178,15 @@ Soup read_ascii(std::string_view bytes, const std::string& name) {
       bool ok = true;
     };
     std::vector<Run> runs(text.size());
-    std::atomic<std::size_t> next{0};
-    parallel_for(
-        std::min<std::size_t>(runs.size(), resolve_thread_count(0)), 0,
-        [&](std::size_t, std::size_t) {
-          for (std::size_t r; (r = next.fetch_add(1)) < runs.size();) try {
-              read_ascii_facets(text[r], name, r == 0, r + 1 == runs.size(), runs[r].raw, runs[r].sizes);
-            } catch (const Irregular&) {
-              runs[r].ok = false;
-            } catch (const Error&) {
-              runs[r].ok = false;
-            }
-        },
-        1);
+    read_runs(runs.size(), [&](std::size_t r) {
+      try {
+        read_ascii_facets(text[r], name, r == 0, r + 1 == runs.size(), runs[r].raw, runs[r].sizes);
+      } catch (const Irregular&) {
+        runs[r].ok = false;
+      } catch (const Error&) {
+        runs[r].ok = false;
+      }
+    });
     std::size_t corners = 0;
     for (const Run& run : runs) {
       in_runs = in_runs && run.ok;
