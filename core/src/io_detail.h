@@ -123,6 +123,24 @@ std::vector<std::string_view> cut_into_runs(std::string_view text, std::size_t b
   return runs;
 }
 
+//! read_runs for the readers that hand the file to one pass when a run is not what they
+//! assumed or fails: false when any run threw Irregular or Error (the runs left are skipped).
+template <class Read>
+bool read_runs_or_give_way(std::size_t n, Read&& read) {
+  std::atomic<bool> ok{true};
+  read_runs(n, [&](std::size_t r) {
+    if (!ok.load(std::memory_order_relaxed)) return;
+    try {
+      read(r);
+    } catch (const Irregular&) {
+      ok = false;
+    } catch (const Error&) {
+      ok = false;
+    }
+  });
+  return ok;
+}
+
 Pieces format_off(const Soup& soup);
 Pieces format_obj(const Soup& soup);
 Pieces format_ply(const Soup& soup, bool binary);

@@ -658,10 +658,9 @@ bool read_text_in_runs(std::string_view bytes, const Header& header, const std::
   struct Run {
     Soup soup;
     Sink sink{soup};
-    bool ok = true;
   };
   std::vector<std::unique_ptr<Run>> runs(text.size());
-  read_runs(runs.size(), [&](std::size_t r) {
+  const bool regular = read_runs_or_give_way(runs.size(), [&](std::size_t r) {
     runs[r] = std::make_unique<Run>();
     Run& run = *runs[r];
     const std::uint64_t a = std::min(first[r], total), b = std::min(first[r + 1], total);
@@ -674,17 +673,10 @@ bool read_text_in_runs(std::string_view bytes, const Header& header, const std::
     s.size(range(first_vertex, nv, b) - s.vertex_base, range(first_face, nf, b) - s.face_base);
     Place place;
     AsciiSource in(text[r], name, place);
-    try {
-      read_body(in, header, place, s, a, b);
-      in.only_blank_lines();
-    } catch (const Irregular&) {
-      run.ok = false;
-    } catch (const Error&) {
-      run.ok = false;
-    }
+    read_body(in, header, place, s, a, b);
+    in.only_blank_lines();
   });
-  for (const auto& run : runs)
-    if (!run->ok) return false;
+  if (!regular) return false;
 
   // Joined in order: vertex and face arrays at their bases, corners one after another.
   std::vector<std::uint64_t> corners_before(runs.size() + 1, 0);

@@ -175,23 +175,13 @@ Soup read_ascii(std::string_view bytes, const std::string& name) {
     struct Run {
       std::vector<Point> raw;
       std::vector<std::uint32_t> sizes;
-      bool ok = true;
     };
     std::vector<Run> runs(text.size());
-    read_runs(runs.size(), [&](std::size_t r) {
-      try {
-        read_ascii_facets(text[r], name, r == 0, r + 1 == runs.size(), runs[r].raw, runs[r].sizes);
-      } catch (const Irregular&) {
-        runs[r].ok = false;
-      } catch (const Error&) {
-        runs[r].ok = false;
-      }
+    in_runs = read_runs_or_give_way(runs.size(), [&](std::size_t r) {
+      read_ascii_facets(text[r], name, r == 0, r + 1 == runs.size(), runs[r].raw, runs[r].sizes);
     });
     std::size_t corners = 0;
-    for (const Run& run : runs) {
-      in_runs = in_runs && run.ok;
-      corners += run.raw.size();
-    }
+    for (const Run& run : runs) corners += run.raw.size();
     if (corners > 0xffffffffu) in_runs = false;
     if (in_runs) {
       raw.reserve(corners);
