@@ -156,8 +156,9 @@ void validated(const Mesh& mesh, const std::string& after) {
 //! itself, such as a hole of three edges filled next to a triangle, or across copies, such as
 //! a flip whose triangle covers a quad visiting one vertex twice), counted per vertex set, are
 //! allowed on top, and so are the defects
-//! of a face an edit spans over two copies of one host vertex: welded back, it would visit that
-//! vertex twice, so extract() keeps copies apart, and whichever it keeps, the face shares its
+//! of every face over two copies of one host vertex, whether an edit spanned it or the input
+//! held it (an edit that splits one changes how the weld resolves it): welded back, it would
+//! visit that vertex twice, so extract() keeps copies apart, and whichever it keeps, the face shares its
 //! edges with the copies' own faces (a repeated vertex, or non-manifold edges and vertices around
 //! it; at most one repeated face, one duplicate and one non-manifold edge and vertex per
 //! corner). HEDGE_FUZZ_RULE=every
@@ -174,8 +175,8 @@ class DefectRule {
     for (int k = 0; k < 4; ++k) allowed_[k] = input_.at(k);
     if (trace_) std::fprintf(stderr, "[rule] input: %s\n", hedge_fuzz::describe(input_).c_str());
   }
-  void built(const Mesh& mesh) {
-    if (!off_) since_ = EditMade::of(mesh);
+  void built(Mesh& mesh) {
+    if (!off_) since_ = EditMade::mark(mesh);
   }
 
   void euler(const Mesh& mesh, const std::string& what) {
@@ -211,17 +212,17 @@ class DefectRule {
       hedge_fuzz::fail(std::string("extract()'s soup does not build again: ") + e.what());
     }
     validated(mesh, "build of the host's soup");
-    if (!off_) since_ = EditMade::of(mesh);
+    if (!off_) since_ = EditMade::mark(mesh);
   }
 
-  void catalogue(const Mesh& mesh, const hedge::Operation& op, const hedge::ParamValues& params) {
+  void catalogue(Mesh& mesh, const hedge::Operation& op, const hedge::ParamValues& params) {
     if (off_) return;
     if (op.id == "subdivide")
       for (std::int64_t i = 0; i < params.get_int("iterations"); ++i, ++subdivisions_) {
         allowed_[0] = 2 * allowed_[0] + 3 * allowed_[2];
         allowed_[2] *= 4;
       }
-    since_ = EditMade::of(mesh);
+    since_ = EditMade::mark(mesh);
     std::string what = op.id + "(";
     for (const auto& [id, value] : params.all())
       what += (what.back() == '(' ? "" : ", ") + id + " = " + hedge::value_text(value);
@@ -237,26 +238,35 @@ class DefectRule {
   //! faces over the vertex set of another once copies are welded (no weld avoids the
   //! duplicate), and faces over two copies of one host vertex, with their corners.
   struct EditMade {
-    //! A vertex as the weld sees it: its host vertex, or, for a vertex an edit or an
-    //! operation made, its place (what stays the same through garbage collection).
-    using Key = std::array<std::uint32_t, 4>;
+    //! A vertex as the weld sees it: its host vertex; else, for a vertex the mesh held when
+    //! last marked, its mark (which garbage collection carries, unlike its index; its place
+    //! would not do, as two vertices may share one); else, for one an edit made, its index.
+    using Key = std::array<std::uint32_t, 2>;
+    static constexpr char kMark[] = "hedge:fuzz_mark";  // internal: extract() leaves it out
+
+    //! Marks every vertex with its index, then counts.
+    static EditMade mark(Mesh& mesh) {
+      auto marks = mesh.vertex_property<std::uint32_t>(kMark, hedge::kInvalidIndex);
+      for (std::size_t i = 0; i < marks.vector().size(); ++i) marks.vector()[i] = std::uint32_t(i);
+      return of(mesh);
+    }
     //! Faces by their welded vertex sets, with how many share each set.
     std::map<std::vector<Key>, std::size_t> sets;
     std::size_t self_welding = 0, self_welding_corners = 0;
 
     static EditMade of(const Mesh& mesh) {
       const auto* source = mesh.vertex_properties().get<std::uint32_t>(hedge::provenance::kVertexSource);
+      const auto* marks = mesh.vertex_properties().get<std::uint32_t>(kMark);
       EditMade made;
       std::vector<Key> set;
       for (Face f : mesh.faces()) {
         set.clear();
         for (Vertex v : mesh.vertices(f)) {
           const std::uint32_t s = source ? source->vector()[v.idx()] : hedge::kInvalidIndex;
-          const hedge::Point& p = mesh.position(v);
-          set.push_back(s != hedge::kInvalidIndex
-                            ? Key{0, s, 0, 0}
-                            : Key{1, std::bit_cast<std::uint32_t>(p[0]), std::bit_cast<std::uint32_t>(p[1]),
-                                  std::bit_cast<std::uint32_t>(p[2])});
+          const std::uint32_t m = marks ? marks->vector()[v.idx()] : hedge::kInvalidIndex;
+          set.push_back(s != hedge::kInvalidIndex   ? Key{0, s}
+                        : m != hedge::kInvalidIndex ? Key{1, m}
+                                                    : Key{2, v.idx()});
         }
         std::sort(set.begin(), set.end());
         const std::size_t corners = set.size();
@@ -271,7 +281,10 @@ class DefectRule {
       return made;
     }
     //! What was made since `before`: per welded vertex set, the duplicates it gained (an edit
-    //! may remove one duplicate and make another; counts alone would miss that).
+    //! may remove one duplicate and make another; counts alone would miss that), and every
+    //! face over copies the mesh holds now, not only new ones: an edit that splits one (such
+    //! as a triangulated quad visiting a host vertex twice) changes how the weld resolves it,
+    //! trading the input's repeated vertex for non-manifold edges.
     struct Gained {
       std::size_t duplicates = 0, self_welding = 0, self_welding_corners = 0;
       //! How many more of defect k (DefectCounts order) the weld of what was made may cost.
@@ -281,7 +294,7 @@ class DefectRule {
     };
     Gained minus(const EditMade& before) const {
       auto gained = [](std::size_t now, std::size_t then) { return now > then ? now - then : 0; };
-      Gained g{0, gained(self_welding, before.self_welding), gained(self_welding_corners, before.self_welding_corners)};
+      Gained g{0, self_welding, self_welding_corners};
       for (const auto& [set, count] : sets) {
         const auto then = before.sets.find(set);
         g.duplicates += gained(count, then == before.sets.end() ? 1 : std::max<std::size_t>(then->second, 1));
