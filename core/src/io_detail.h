@@ -217,7 +217,7 @@ class TextScanner {
         continuation_(continuation) {}
 
   //! The next token on the current line; empty at the end of the line or file.
-  std::string_view line_token() {
+  [[gnu::always_inline]] std::string_view line_token() {
     skip_space_in_line();
     const char* start = p_;
     if (continuation_) {
@@ -248,7 +248,7 @@ class TextScanner {
   }
 
   //! True when nothing but spaces or a comment is left on the current line.
-  bool at_line_end() {
+  [[gnu::always_inline]] bool at_line_end() {
     skip_space_in_line();
     return p_ == end_ || *p_ == '\n';
   }
@@ -301,7 +301,7 @@ class TextScanner {
     return p == end_ || *p == '\n';
   }
 
-  void skip_space_in_line() {
+  [[gnu::always_inline]] void skip_space_in_line() {
     for (;;) {
       while (p_ < end_ && (*p_ == ' ' || *p_ == '\t' || *p_ == '\r' || *p_ == '\v' || *p_ == '\f')) ++p_;
       if (p_ == end_) return;

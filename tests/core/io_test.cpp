@@ -471,6 +471,37 @@ std::size_t expect_same_in_runs(const std::vector<std::string>& files, Reader re
   return split;
 }
 
+TEST(IoOff, BodyInRunsReadsAsTheWholeFile) {
+  // The body is cut into runs of lines, each run's elements numbered by the element lines
+  // (neither blank nor a comment) before it: every run size gives the soup, or the error,
+  // of the file read whole.
+  const std::string vertices = "0 0 0 255 0 0\n1 0 0 0 255 0\n# a comment\n0 1 0 0 0 255\n\n1 1 0.5 9 9 9\n";
+  const std::vector<std::string> files = {
+      "COFF\n4 3 0\n" + vertices + "3 0 1 2\n3 1 3 2 1 0 0\n  4 0 1 3 2 # a quad\n",
+      "COFF\n4 3 0\n" + vertices + "3 0 1 2 0.5 0.5 0.5 1\n3 1 3 2\n4 0 1 3 2 7\n\n# the end\n",
+      "COFF\n4 3\n" + vertices + "3 0 1 2\r\n3 1 3 2\r\n4 0 1 3 2",
+      "NOFF\n3 1\n0 0 0 0 0 1\n1 0 0 0 0 1\n0 1 0 0 0 1\n3 0 1 2\n",
+      // Errors: truncated, one element too many, a bad number, too many values, a face on two
+      // lines, more indices than the file can hold.
+      "COFF\n4 3 0\n" + vertices + "3 0 1 2\n3 1 3 2\n",
+      "COFF\n4 3 0\n" + vertices + "3 0 1 2\n3 1 3 2\n4 0 1 3 2\n3 0 1 2\n",
+      "COFF\n4 3 0\n" + vertices + "3 0 1 2\n3 1 x 2\n4 0 1 3 2\n",
+      "COFF\n4 3 0\n" + vertices + "3 0 1 2\n3 1 3 2 1 1 1 1 1\n4 0 1 3 2\n",
+      "COFF\n4 3 0\n" + vertices + "3 0 1 2\n3 1 3\n2\n4 0 1 3 2\n",
+      "COFF\n4 3 0\n" + vertices + "3 0 1 2\n4000000000 1 3 2\n4 0 1 3 2\n",
+      "COFF\n4 3 0\n0 0 0 255 0 0\n1 0 0\n0 1 0 0 0 255\n1 1 0.5 9 9 9\n3 0 1 2\n3 1 3 2\n4 0 1 3 2\n",
+  };
+  auto read = [](const std::string& text) { return read_off(text, "runs.off"); };
+  EXPECT_GT(expect_same_in_runs(files, read), 0u);
+  // What the first two files hold, read whole.
+  const Soup s = read(files[0]);
+  EXPECT_EQ(s.corners, (std::vector<std::uint32_t>{0, 1, 2, 1, 3, 2, 0, 1, 3, 2}));
+  EXPECT_EQ(values<std::uint8_t>(channel(s, "color", Domain::face)),
+            (std::vector<std::uint8_t>{255, 255, 255, 255, 255, 0, 0, 255, 255, 255, 255, 255}));
+  EXPECT_EQ(values<std::uint8_t>(channel(read(files[1]), "color", Domain::face)),
+            (std::vector<std::uint8_t>{128, 128, 128, 255, 255, 255, 255, 255, 255, 255, 255, 255}));
+}
+
 TEST(IoObj, RunsOfAnySizeReadAsTheWholeFile) {
   // The reader cuts a file into runs of lines, read on several threads and joined: every
   // run size gives the soup, or the error (line and message), of the file read whole.

@@ -130,9 +130,9 @@ inline void check_build_round_trip(const hedge::Soup& soup, bool with_input = fa
   if (with_input) check_extract_with_input(built, soup, expected);
 }
 
-//! Reads `bytes` with `read` whole, then in runs of a few bytes on two threads (the OBJ, PLY
-//! text and STL text readers cut big files into runs read side by side): the same soup, or the same
-//! error, must come back; then what was read must build and round-trip.
+//! Reads `bytes` with `read` whole, then in runs of a few bytes on two threads (the text readers
+//! cut big files into runs read side by side): the same soup, or the same error, must come back;
+//! then what was read must build and round-trip.
 template <class Read>
 void check_reader(std::string_view bytes, Read read) {
   struct Result {
