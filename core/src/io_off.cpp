@@ -68,8 +68,8 @@ bool parse_color(const std::string_view* tokens, std::size_t n, std::uint8_t* rg
 
 constexpr std::size_t kMaxLineTokens = 64;
 
-//! The tokens left on a line. Kept from line to line by its reader: clearing 64 views for
-//! every line took a third of the reading time.
+//! The tokens left on a line. Kept from line to line by its reader, so that its 64 views
+//! are not cleared for every line.
 struct LineRest {
   std::string_view tokens[kMaxLineTokens];
   std::size_t n = 0;
@@ -206,16 +206,13 @@ bool read_body_in_runs(std::string_view body, const std::string& name, std::uint
   // Pass 2: each face's size, so each run knows where its corners go.
   faces.sizes.resize(nf);
   std::vector<std::uint64_t> corners_before(n + 1, 0);
-  auto skip_vertices = [&](TextScanner& in, std::size_t r) {
-    for (std::uint64_t i = first[r]; i < std::min(first[r + 1], nv); ++i) {
-      in.skip_space();
-      in.next_line();
-    }
-  };
   bool regular = read_runs_or_give_way(n, [&](std::size_t r) {
     if (first[r + 1] <= nv) return;
     TextScanner in(text[r], name, '#');
-    skip_vertices(in, r);
+    for (std::uint64_t v = first[r]; v < nv; ++v) {
+      in.skip_space();
+      in.next_line();
+    }
     std::uint64_t corners = 0;
     for (std::uint64_t f = std::max(first[r], nv) - nv; f < first[r + 1] - nv; ++f) {
       in.skip_space();
