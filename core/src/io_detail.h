@@ -123,6 +123,24 @@ std::vector<std::string_view> cut_into_runs(std::string_view text, std::size_t b
   return runs;
 }
 
+//! A text body cut at line breaks into runs of about run_bytes(), for readers that read one
+//! element a line, and the elements before each run.
+struct LineRuns {
+  std::vector<std::string_view> text;
+  std::vector<std::uint64_t> first;  //!< elements before run r; the last entry holds them all
+};
+
+//! `body` as LineRuns, `count_elements(run)` telling the elements in each run (on all threads).
+template <class CountElements>
+LineRuns cut_into_line_runs(std::string_view body, CountElements count_elements) {
+  LineRuns runs;
+  runs.text = cut_into_runs(body, run_bytes(), [](std::string_view, std::size_t) { return true; });
+  runs.first.assign(runs.text.size() + 1, 0);
+  read_runs(runs.text.size(), [&](std::size_t r) { runs.first[r + 1] = count_elements(runs.text[r]); });
+  for (std::size_t r = 0; r < runs.text.size(); ++r) runs.first[r + 1] += runs.first[r];
+  return runs;
+}
+
 //! read_runs for the readers that hand the file to one pass when a run is not what they
 //! assumed or fails: false when any run threw Irregular or Error (the runs left are skipped).
 template <class Read>

@@ -193,15 +193,12 @@ std::uint64_t count_element_lines(std::string_view text) {
 bool read_body_in_runs(std::string_view body, const std::string& name, std::uint64_t nv, std::uint64_t nf,
                        const OffVertices& vertices, OffFaces& faces) {
   if (body.size() < 2 * run_bytes() || resolve_thread_count(0) < 2) return false;
-  const std::vector<std::string_view> text =
-      cut_into_runs(body, run_bytes(), [](std::string_view, std::size_t) { return true; });
-  const std::size_t n = text.size();
-
   // Pass 1: the elements before each run.
-  std::vector<std::uint64_t> first(n + 1, 0);
-  read_runs(n, [&](std::size_t r) { first[r + 1] = count_element_lines(text[r]); });
-  for (std::size_t r = 0; r < n; ++r) first[r + 1] += first[r];
+  const LineRuns runs = cut_into_line_runs(body, count_element_lines);
+  const std::vector<std::string_view>& text = runs.text;
+  const std::vector<std::uint64_t>& first = runs.first;
   if (first.back() != nv + nf) return false;
+  const std::size_t n = text.size();
 
   // Pass 2: each face's size, so each run knows where its corners go.
   faces.sizes.resize(nf);

@@ -640,19 +640,12 @@ bool read_text_in_runs(std::string_view bytes, const Header& header, const std::
     if (e.kind == Kind::face) first_face = total, nf = e.count;
     total += e.count;
   }
-  const std::vector<std::string_view> text =
-      cut_into_runs(body, run_bytes(), [](std::string_view, std::size_t) { return true; });
-  // Lines before each run: one element each.
-  std::vector<std::uint64_t> first(text.size() + 1, 0);
-  parallel_for(
-      text.size(), 0,
-      [&](std::size_t begin, std::size_t end) {
-        for (std::size_t r = begin; r < end; ++r)
-          first[r + 1] = std::uint64_t(std::count(text[r].begin(), text[r].end(), '\n')) +
-                         (r + 1 == text.size() && text[r].back() != '\n');
-      },
-      1);
-  for (std::size_t r = 0; r < text.size(); ++r) first[r + 1] += first[r];
+  // One element a line.
+  const LineRuns lines = cut_into_line_runs(body, [](std::string_view run) {
+    return std::uint64_t(std::count(run.begin(), run.end(), '\n')) + (run.back() != '\n');
+  });
+  const std::vector<std::string_view>& text = lines.text;
+  const std::vector<std::uint64_t>& first = lines.first;
   if (first.back() < total) return false;  // fewer lines than elements
 
   struct Run {
