@@ -154,8 +154,8 @@ void validated(const Mesh& mesh, const std::string& after) {
 //! step by step. Euler operations are edits, not operations: the faces they make over the
 //! vertex set of another once copies are welded (no weld avoids those duplicates; in the mesh
 //! itself, such as a hole of three edges filled next to a triangle, or across copies, such as
-//! a flip whose triangle covers a quad visiting one vertex twice), counted per vertex set, are
-//! allowed on top, and so are the defects
+//! a flip whose triangle covers a quad visiting one vertex twice), counted per welded vertex
+//! set and per set of the mesh's own vertices within it, are allowed on top, and so are the defects
 //! of every face over two copies of one host vertex, whether an edit spanned it or the input
 //! held it (an edit that splits one changes how the weld resolves it): welded back, it would
 //! visit that vertex twice, so extract() keeps copies apart, and whichever it keeps, the face shares its
@@ -250,25 +250,32 @@ class DefectRule {
       for (std::size_t i = 0; i < marks.vector().size(); ++i) marks.vector()[i] = std::uint32_t(i);
       return of(mesh);
     }
-    //! Faces by their welded vertex sets, with how many share each set.
-    std::map<std::vector<Key>, std::size_t> sets;
+    //! Per welded vertex set: how many faces share it, and how many of those repeat the mesh
+    //! vertices of another (duplicates in the mesh itself, which no weld avoids).
+    struct SetCount {
+      std::size_t faces = 0, same_vertices = 0;
+    };
+    std::map<std::vector<Key>, SetCount> sets;
     std::size_t self_welding = 0, self_welding_corners = 0;
 
     static EditMade of(const Mesh& mesh) {
       const auto* source = mesh.vertex_properties().get<std::uint32_t>(hedge::provenance::kVertexSource);
       const auto* marks = mesh.vertex_properties().get<std::uint32_t>(kMark);
       EditMade made;
-      std::vector<Key> set;
+      std::vector<Key> set, own;
+      std::map<std::vector<Key>, std::vector<Key>> seen;  // each face's own vertices -> its welded set
       for (Face f : mesh.faces()) {
         set.clear();
+        own.clear();
         for (Vertex v : mesh.vertices(f)) {
           const std::uint32_t s = source ? source->vector()[v.idx()] : hedge::kInvalidIndex;
           const std::uint32_t m = marks ? marks->vector()[v.idx()] : hedge::kInvalidIndex;
-          set.push_back(s != hedge::kInvalidIndex   ? Key{0, s}
-                        : m != hedge::kInvalidIndex ? Key{1, m}
-                                                    : Key{2, v.idx()});
+          const Key itself = m != hedge::kInvalidIndex ? Key{1, m} : Key{2, v.idx()};
+          set.push_back(s != hedge::kInvalidIndex ? Key{0, s} : itself);
+          own.push_back(itself);
         }
         std::sort(set.begin(), set.end());
+        std::sort(own.begin(), own.end());
         const std::size_t corners = set.size();
         const auto copies = [](const Key& a, const Key& b) { return a[0] == 0 && a == b; };
         if (std::adjacent_find(set.begin(), set.end(), copies) != set.end()) {
@@ -276,7 +283,9 @@ class DefectRule {
           made.self_welding_corners += corners;
         }
         set.erase(std::unique(set.begin(), set.end()), set.end());
-        ++made.sets[set];
+        SetCount& count = made.sets[set];
+        ++count.faces;
+        if (!seen.emplace(own, set).second) ++count.same_vertices;
       }
       return made;
     }
@@ -295,9 +304,13 @@ class DefectRule {
     Gained minus(const EditMade& before) const {
       auto gained = [](std::size_t now, std::size_t then) { return now > then ? now - then : 0; };
       Gained g{0, self_welding, self_welding_corners};
+      // Either way: more faces on a welded set, or as many, but more of them on one and the
+      // same vertices (an edit deleted a face over copies and filled a hole over the other's).
       for (const auto& [set, count] : sets) {
         const auto then = before.sets.find(set);
-        g.duplicates += gained(count, then == before.sets.end() ? 1 : std::max<std::size_t>(then->second, 1));
+        const SetCount was = then == before.sets.end() ? SetCount{} : then->second;
+        g.duplicates += std::max(gained(count.faces, std::max<std::size_t>(was.faces, 1)),
+                                 gained(count.same_vertices, was.same_vertices));
       }
       return g;
     }
