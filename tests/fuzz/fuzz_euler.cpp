@@ -15,6 +15,7 @@
 #include <cstdlib>
 #include <map>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -263,7 +264,7 @@ class DefectRule {
       const auto* marks = mesh.vertex_properties().get<std::uint32_t>(kMark);
       EditMade made;
       std::vector<Key> set, own;
-      std::map<std::vector<Key>, std::vector<Key>> seen;  // each face's own vertices -> its welded set
+      std::set<std::vector<Key>> seen;  // the faces' own vertex sets
       for (Face f : mesh.faces()) {
         set.clear();
         own.clear();
@@ -285,7 +286,7 @@ class DefectRule {
         set.erase(std::unique(set.begin(), set.end()), set.end());
         SetCount& count = made.sets[set];
         ++count.faces;
-        if (!seen.emplace(own, set).second) ++count.same_vertices;
+        if (!seen.insert(own).second) ++count.same_vertices;
       }
       return made;
     }
