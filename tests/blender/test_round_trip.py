@@ -141,6 +141,27 @@ class RoundTripTest(unittest.TestCase):
             self.assertTrue(np.array_equal(before[key], after[key]), key)
         self.assertEqual(obj.vertex_groups["g"].weight(2), 0.5)
 
+    def test_booleans_read_from_blenders_arrays(self):
+        """Where Blender copies booleans element by element (3.x), the flags and boolean
+        attributes are read from its own arrays, bit for bit what foreach_get reads; elsewhere
+        foreach_get reads them."""
+        obj = add_primitive("monkey")
+        decorate(obj)
+        me = obj.data
+        attribute = next(a for a in me.attributes if a.data_type == 'BOOLEAN' and not a.name.startswith("."))
+        read = [(me.polygons, "use_smooth"), (me.edges, "use_seam"), (me.edges, "use_edge_sharp"),
+                (attribute.data, "value")]
+        for collection, prop in read:
+            expected = np.zeros(len(collection), np.bool_)
+            collection.foreach_get(prop, expected)
+            self.assertTrue(expected.any() and not expected.all(), prop)
+            values = np.zeros(len(collection), np.bool_)
+            taken = exchange._read_bits(collection, prop, values)
+            self.assertEqual(taken, exchange.BOOLEANS_ELEMENT_BY_ELEMENT and not (
+                prop == "use_smooth" and ("polygons", "use_smooth") in exchange.builtin_attributes()), prop)
+            if taken:
+                self.assertTrue(np.array_equal(values, expected), prop)
+
     def test_read_into_buffers(self):
         """Read into the native module's buffers, the soup is the same as read into numpy's
         arrays; its big arrays lie in the buffers (an operation reads them without a copy), the
