@@ -231,6 +231,13 @@ def _builtin(me, name, n, dtype, default, components=1, zeros=np.zeros):
     return _get(attribute.data, "value", n, dtype, components, zeros)
 
 
+def _held(me, collection, prop):
+    """False when the running Blender keeps the element property as an attribute and the mesh
+    has none (every element has the default)."""
+    name = builtin_attributes().get((collection, prop))
+    return name is None or name in me.attributes
+
+
 def _flag(me, collection, prop, n, dtype, zeros=np.zeros):
     """An element property (selection, hiding, material, smooth shading, edge flags), from its
     attribute where the running Blender keeps one ("sharp_face" holds smooth shading inverted)."""
@@ -250,6 +257,16 @@ def _set(collection, prop, values):
 
 
 _DOMAIN_OF = {"vertices": 'POINT', "edges": 'EDGE', "polygons": 'FACE'}
+# The element properties that cross as channels: (channel, domain, collection, property, type).
+_FLAG_CHANNELS = (("material", "face", "polygons", "material_index", np.int32),
+                  ("smooth", "face", "polygons", "use_smooth", np.bool_),
+                  ("selected", "vertex", "vertices", "select", np.bool_),
+                  ("selected", "face", "polygons", "select", np.bool_),
+                  ("hidden", "vertex", "vertices", "hide", np.bool_),
+                  ("hidden", "face", "polygons", "hide", np.bool_),
+                  ("bevel_weight", "vertex", "vertices", "bevel_weight", np.float32))
+# Those that stay out of the soup when the mesh does not hold them: written as defaults.
+_DEFAULT_WHEN_ABSENT = {"material", "selected", "hidden"}
 
 
 def _put_flag(me, collection, prop, values):
@@ -308,6 +325,18 @@ class MeshData:
         self.buffers = None       # the native SoupBuffers the soup's arrays lie in, if any
 
 
+def _gaps_in_place(values, end, run=1 << 16):
+    """Turns rising starts into the gaps between them, in place (the last one's gap is to
+    `end`), a run of elements at a time, so that no array of their size is made besides: on
+    a large mesh fresh memory costs more than the subtraction."""
+    n = len(values)
+    for first in range(0, n - 1, run):
+        last = min(first + run, n - 1)
+        np.subtract(values[first + 1:last + 1], values[first:last], out=values[first:last])
+    if n:
+        values[-1] = end - values[-1]
+
+
 def read_mesh(me, edges=True, buffers=None):
     """Reads a bpy.types.Mesh (object mode data) into a MeshData; its edges' data too unless
     `edges` is False (read_edges() then reads them before writing back). Given `buffers` (the
@@ -330,15 +359,17 @@ def read_mesh(me, edges=True, buffers=None):
         d.buffers = into
     positions = _get(*_positions(me), nv, np.float32, 3, own_positions)
     builtin = builtin_attributes()
-    loop_start = _get(me.polygons, "loop_start", nf, np.int32)
+    # The loop starts are read into the sizes' buffer and become the sizes there: each
+    # polygon's size is the gap to the next start. Starts rising from 0 are the loops in
+    # polygon order; otherwise (possible before 3.6) they are read again, the sizes read and
+    # the order checked.
     loop_total = own_sizes(nf, np.int32)
-    loop_total[:-1] = loop_start[1:] - loop_start[:-1]
-    if nf:
-        loop_total[-1] = nl - loop_start[-1]
-    # Starts rising from 0 are the loops in polygon order, each polygon's size the gap to the
-    # next start; otherwise (possible before 3.6) the sizes are read and the order checked.
-    in_order = not nf or (loop_start[0] == 0 and np.all(loop_total > 0))
+    _get(me.polygons, "loop_start", nf, np.int32, zeros=lambda size, dtype: loop_total.view(dtype))
+    in_order = not nf or loop_total[0] == 0
+    _gaps_in_place(loop_total, nl)
+    in_order = in_order and (not nf or loop_total.min() > 0)
     if not in_order:
+        loop_start = _get(me.polygons, "loop_start", nf, np.int32)
         _get(me.polygons, "loop_total", nf, np.int32, zeros=lambda size, dtype: loop_total.view(dtype))
     if ".corner_vert" in builtin:
         vertex_index = _builtin(me, ".corner_vert", nl, np.int32, 0, zeros=own_corners)
@@ -408,15 +439,17 @@ def read_mesh(me, edges=True, buffers=None):
             channels.append((ATTRIBUTE_PREFIX + name, domain, values))
             d.attributes.append((name, attr.data_type, attr.domain))
 
-    material = _flag(me, "polygons", "material_index", nf, np.int32, zeros)
-    smooth = _flag(me, "polygons", "use_smooth", nf, np.bool_, zeros)
-    flags = [_flag(me, collection, prop, n, np.bool_, zeros) for collection, prop, n in (
-        ("vertices", "select", nv), ("polygons", "select", nf), ("vertices", "hide", nv), ("polygons", "hide", nf))]
-    channels.append(("material", "face", material))
-    channels.append(("smooth", "face", smooth.view(np.uint8)))
-    for (name, domain), values in zip((("selected", "vertex"), ("selected", "face"), ("hidden", "vertex"),
-                                       ("hidden", "face")), flags):
-        channels.append((name, domain, values.view(np.uint8)))
+    # Materials, selection and hiding cross only when the mesh holds them: absent, every
+    # element has the default, which new geometry has too (the write makes sure), and no
+    # operation tells an absent channel from one of defaults (the selection: both or neither).
+    selected = _held(me, "vertices", "select") or _held(me, "polygons", "select")
+    for name, domain, collection, prop, dtype in _FLAG_CHANNELS:
+        if name == "bevel_weight":
+            continue  # below: a 3.x layer of its own
+        if name in _DEFAULT_WHEN_ABSENT and not (selected if name == "selected" else _held(me, collection, prop)):
+            continue
+        values = _flag(me, collection, prop, sizes[domain], dtype, zeros)
+        channels.append((name, domain, values.view(np.uint8) if dtype == np.bool_ else values))
     if LEGACY_LAYERS and me.has_bevel_weight_vertex:
         channels.append(("bevel_weight", "vertex", _get(me.vertices, "bevel_weight", nv, np.float32)))
     channels.append(("blender:vertex", "vertex", np.arange(nv, dtype=np.int32)))
@@ -725,17 +758,12 @@ def _write_attributes(me, data, result, create, loop_inverse=None):
         if data.render_color and data.render_color in me.color_attributes:
             me.color_attributes.render_color_index = me.color_attributes.find(data.render_color)
 
-    for name, domain, collection, prop, dtype in (
-            ("material", "face", "polygons", "material_index", np.int32),
-            ("smooth", "face", "polygons", "use_smooth", np.bool_),
-            ("selected", "vertex", "vertices", "select", np.bool_),
-            ("selected", "face", "polygons", "select", np.bool_),
-            ("hidden", "vertex", "vertices", "hide", np.bool_),
-            ("hidden", "face", "polygons", "hide", np.bool_),
-            ("bevel_weight", "vertex", "vertices", "bevel_weight", np.float32)):
+    for name, domain, collection, prop, dtype in _FLAG_CHANNELS:
         values = channel(soup, name, domain)
         if values is None:
-            continue
+            if not create or name not in _DEFAULT_WHEN_ABSENT:
+                continue
+            values = np.zeros(len(getattr(me, collection)), dtype)  # the mesh held none
         values = values.view(dtype) if dtype == np.bool_ else values.astype(dtype, copy=False)
         # What new geometry holds already (zeros, False; smooth faces from 4.1 on), read the fast
         # way where Blender keeps it as an attribute (new geometry has none but "sharp_face").

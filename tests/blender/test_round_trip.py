@@ -11,8 +11,9 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 import unittest  # noqa: E402
-from blender_test import (FREESTYLE_MARKS, LAYERS, add_primitive, clear_scene, install_addon,  # noqa: E402
-                          is_edge_key, mesh_arrays, mesh_path, run_tests, set_layer)
+from blender_test import (FREESTYLE_MARKS, LAYERS, add_primitive, clear_scene, faces_of, get,  # noqa: E402
+                          install_addon, is_edge_key, mesh_arrays, mesh_path, object_from_pydata, run_tests,
+                          set_layer)
 
 hedge = install_addon()
 from hedge import exchange  # noqa: E402
@@ -161,6 +162,57 @@ class RoundTripTest(unittest.TestCase):
                 prop == "use_smooth" and ("polygons", "use_smooth") in exchange.builtin_attributes()), prop)
             if taken:
                 self.assertTrue(np.array_equal(values, expected), prop)
+
+    def test_loops_out_of_polygon_order(self):
+        """Loops stored in another order than their polygons (Blender before 4.0 lets a script
+        write the starts and totals; later ones keep them in order) are read in polygon order,
+        into the buffers too."""
+        obj = object_from_pydata("shuffled", [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0), (2, 0, 0)],
+                                 [(0, 1, 2, 3), (1, 4, 2)])
+        me = obj.data
+        if exchange.LOOP_TOTAL_WRITABLE:
+            me.polygons.foreach_set("loop_start", np.array([3, 0], np.uint32))
+            me.polygons.foreach_set("loop_total", np.array([4, 3], np.uint32))
+            me.loops.foreach_set("vertex_index", np.array([1, 4, 2, 0, 1, 2, 3], np.uint32))
+            self.assertEqual(get(me.polygons, "loop_start", 2, np.int32).tolist(), [3, 0])
+        self.assertEqual(faces_of(me), [(0, 1, 2, 3), (1, 4, 2)])
+        for buffers in (None, native.SoupBuffers):
+            soup = exchange.read_mesh(me, buffers=buffers).soup
+            self.assertEqual(soup["face_sizes"].tolist(), [4, 3])
+            self.assertEqual(soup["corners"].tolist(), [0, 1, 2, 3, 1, 4, 2])
+
+    def test_flags_cross_only_when_held(self):
+        """Materials, selection and hiding that the mesh does not hold as attributes (every
+        element has the default) stay out of the soup, and an operation's result holds the
+        defaults; a mesh holding only its faces' selection sends both selections."""
+        obj = object_from_pydata("plain", [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0), (2, 0, 0), (2, 1, 0)],
+                                 [(0, 1, 2, 3), (1, 4, 5, 2)])
+        me = obj.data
+        held = exchange.builtin_attributes()
+        flags = {("material", "face"): ("polygons", "material_index"), ("hidden", "vertex"): ("vertices", "hide"),
+                 ("hidden", "face"): ("polygons", "hide"), ("selected", "vertex"): ("vertices", "select"),
+                 ("selected", "face"): ("polygons", "select")}
+        for name in [held[f] for f in flags.values() if f in held]:
+            if name in me.attributes:
+                me.attributes.remove(me.attributes[name])
+
+        def crossing():
+            return {(n, d) for n, d, _ in exchange.read_mesh(me).soup["channels"]}
+
+        expected = set() if all(f in held for f in flags.values()) else {
+            key for key, f in flags.items() if f not in held}
+        self.assertEqual(crossing() & set(flags), expected)
+        self.assertIn(("smooth", "face"), crossing())
+        hedge.run(obj, "triangulate")
+        self.assertEqual(len(me.polygons), 4)
+        for collection, prop in flags.values():
+            values = get(getattr(me, collection), prop, len(getattr(me, collection)), np.int32)
+            self.assertFalse(values.any(), prop)
+        if ("polygons", "select") in held:
+            me.polygons[0].select = True
+            if held[("vertices", "select")] in me.attributes:
+                me.attributes.remove(me.attributes[held[("vertices", "select")]])
+            self.assertLessEqual({("selected", "vertex"), ("selected", "face")}, crossing())
 
     def test_read_into_buffers(self):
         """Read into the native module's buffers, the soup is the same as read into numpy's
