@@ -337,6 +337,17 @@ def _gaps_in_place(values, end, run=1 << 16):
         values[-1] = end - values[-1]
 
 
+def _indices(n, zeros, run=1 << 16):
+    """0 to n - 1 (int32) in an array that zeros(n, dtype) makes, a run at a time: np.arange
+    would make an array of its own, which the native module would then copy."""
+    out = zeros(n, np.int32)
+    first_run = np.arange(min(n, run), dtype=np.int32)
+    for first in range(0, n, run):
+        count = min(run, n - first)
+        np.add(first_run[:count], first, out=out[first:first + count])
+    return out
+
+
 def read_mesh(me, edges=True, buffers=None):
     """Reads a bpy.types.Mesh (object mode data) into a MeshData; its edges' data too unless
     `edges` is False (read_edges() then reads them before writing back). Given `buffers` (the
@@ -452,7 +463,7 @@ def read_mesh(me, edges=True, buffers=None):
         channels.append((name, domain, values.view(np.uint8) if dtype == np.bool_ else values))
     if LEGACY_LAYERS and me.has_bevel_weight_vertex:
         channels.append(("bevel_weight", "vertex", _get(me.vertices, "bevel_weight", nv, np.float32)))
-    channels.append(("blender:vertex", "vertex", np.arange(nv, dtype=np.int32)))
+    channels.append(("blender:vertex", "vertex", _indices(nv, zeros)))
 
     if me.has_custom_normals:
         d.not_carried.append("custom split normals")

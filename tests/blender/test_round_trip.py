@@ -214,6 +214,11 @@ class RoundTripTest(unittest.TestCase):
                 me.attributes.remove(me.attributes[held[("vertices", "select")]])
             self.assertLessEqual({("selected", "vertex"), ("selected", "face")}, crossing())
 
+    def test_vertex_indices_in_runs(self):
+        """The source vertex indices are made a run at a time, across runs and in part of one."""
+        for n in (0, 1, 7, 1 << 16, (1 << 16) + 1, 200_001):
+            self.assertTrue(np.array_equal(exchange._indices(n, np.zeros), np.arange(n, dtype=np.int32)), n)
+
     def test_read_into_buffers(self):
         """Read into the native module's buffers, the soup is the same as read into numpy's
         arrays; its big arrays lie in the buffers (an operation reads them without a copy), the
@@ -230,7 +235,7 @@ class RoundTripTest(unittest.TestCase):
         self.assertEqual([(n, d) for n, d, _ in soup["channels"]], [(n, d) for n, d, _ in plain.soup["channels"]])
         for (name, domain, values), (_, _, expected) in zip(soup["channels"], plain.soup["channels"]):
             self.assertTrue(np.array_equal(values, expected), f"{name} ({domain})")
-            if name in ("uv:UVMap", "material", "selected"):
+            if name in ("uv:UVMap", "material", "selected", "blender:vertex"):
                 owner = values
                 while isinstance(owner, np.ndarray):
                     owner = owner.base
