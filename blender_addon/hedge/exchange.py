@@ -154,9 +154,9 @@ def _bit_layout(collection, prop):
 
 
 def _probe_bit_layouts(me):
-    """_bit_layouts for the mesh's boolean element properties and for boolean attributes."""
-    flags = [(c, p) for c, p, first, _ in _BUILTIN_PROBE if first is True] + [("edges", p) for p, _ in EDGE_FLAGS]
-    for collection_name, prop in flags:
+    """_bit_layouts for the mesh's boolean element properties (those the attribute probe sets,
+    the edge flags among them) and for boolean attributes."""
+    for collection_name, prop in [(c, p) for c, p, first, _ in _BUILTIN_PROBE if first is True]:
         collection = getattr(me, collection_name)
         if prop in collection[0].bl_rna.properties:
             _bit_layouts[(collection[0].bl_rna.identifier, prop)] = _bit_layout(collection, prop)
