@@ -148,9 +148,11 @@ def _bit_layout(collection, prop):
     if collection[0].as_pointer() != start:
         return None
     changed = [(i, a ^ b) for i, (a, b) in enumerate(zip(on, off)) if a != b]
-    if len(changed) != 1 or changed[0][1] & (changed[0][1] - 1) or not on[changed[0][0]] & changed[0][1]:
+    if len(changed) != 1:
         return None
-    return (stride, *changed[0])
+    byte, bit = changed[0]
+    one_bit = bit & (bit - 1) == 0
+    return (stride, byte, bit) if one_bit and on[byte] & bit else None
 
 
 def _probe_bit_layouts(me):
