@@ -28,10 +28,6 @@
 #include "text.h"
 #include "weld.h"
 
-#ifdef __linux__
-#include <sys/mman.h>
-#endif
-
 namespace hedge {
 namespace {
 
@@ -84,37 +80,19 @@ std::vector<Part> parallel_parts(const std::vector<std::uint32_t>& offsets, unsi
   });
 }
 
-// Memory for the big temporary arrays: uninitialised (every element is written before it
-// is read), and on transparent huge pages where Linux offers them. In a virtual machine a
-// 4 KiB page fault can cost more than writing the page, and these arrays are written once.
-void* allocate_scratch(std::size_t bytes) {
-  constexpr std::size_t kHugePage = std::size_t(2) << 20;
-  void* p = nullptr;
-  if (bytes >= kHugePage) {
-    const std::size_t rounded = (bytes + kHugePage - 1) / kHugePage * kHugePage;
-    p = std::aligned_alloc(kHugePage, rounded);
-#ifdef __linux__
-    if (p) madvise(p, rounded, MADV_HUGEPAGE);  // only a hint: small pages otherwise
-#endif
-  } else {
-    p = std::malloc(bytes ? bytes : 1);
-  }
-  if (!p) throw std::bad_alloc();
-  return p;
-}
-
 struct FreeScratch {
-  void operator()(void* p) const { std::free(p); }
+  void operator()(void* p) const { detail::free_array(p); }
 };
 
-//! An uninitialised array of n trivial T in scratch memory.
+//! An uninitialised array of n trivial T, for the big temporary arrays (written once, every
+//! element before it is read); on huge pages where Linux offers them (detail/memory.h).
 template <class T>
 class Scratch {
   static_assert(std::is_trivially_copyable_v<T> && std::is_trivially_destructible_v<T>);
 
  public:
   Scratch() = default;
-  explicit Scratch(std::size_t n) : memory_(allocate_scratch(n * sizeof(T))), bytes_(n * sizeof(T)) {
+  explicit Scratch(std::size_t n) : memory_(detail::allocate_array(n * sizeof(T), alignof(T))), bytes_(n * sizeof(T)) {
     data_ = new (memory_.get()) T[n];
   }
   T& operator[](std::size_t i) { return data_[i]; }

@@ -2,17 +2,29 @@
 // its member types and inline functions, nothing outside the core should use them.
 #pragma once
 
+#include <cstddef>
+#include <limits>
 #include <memory>
+#include <new>
 #include <type_traits>
 #include <utility>
 
 namespace hedge::detail {
 
+//! Memory for an array of `bytes`, aligned to `alignment`, uninitialised; throws
+//! std::bad_alloc. Arrays of 2 MiB or more are asked for on transparent huge pages where
+//! Linux offers them (a hint; small pages otherwise): the mesh's arrays are read in random
+//! order, where small pages mean a TLB miss at nearly every step, and each 4 KiB page's
+//! first touch is a fault, which costs far more than writing the page in a virtual machine.
+//! Give it back with free_array().
+void* allocate_array(std::size_t bytes, std::size_t alignment);
+void free_array(void* p) noexcept;
+
 //! std::allocator, except that an element made without a value (resize(n), emplace_back())
 //! is left unset. The mesh's connectivity arrays use it so that a builder that writes every
 //! field itself (Mesh::resize_unset) does not pay for a fill first: on a big mesh that fill
 //! is one thread taking every page fault of tens of megabytes, which the builder's own
-//! writes, spread over its threads, take anyway.
+//! writes, spread over its threads, take anyway. Its memory comes from allocate_array().
 template <class T>
 struct UnsetAllocator : std::allocator<T> {
   static_assert(std::is_trivially_copyable_v<T> && std::is_trivially_destructible_v<T>);
@@ -24,6 +36,11 @@ struct UnsetAllocator : std::allocator<T> {
   struct rebind {
     using other = UnsetAllocator<U>;
   };
+  T* allocate(std::size_t n) {
+    if (n > std::numeric_limits<std::size_t>::max() / sizeof(T)) throw std::bad_array_new_length();
+    return static_cast<T*>(allocate_array(n * sizeof(T), alignof(T)));
+  }
+  void deallocate(T* p, std::size_t) noexcept { free_array(p); }
   template <class U>
   void construct(U*) noexcept {}
   template <class U, class... Args>
