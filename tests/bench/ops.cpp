@@ -75,24 +75,32 @@ void measure(Row& row, const hedge::Soup& output, const Reference& ref) {
   }
 }
 
-Row run_library(const OpEntry& entry, const std::string& library, int reps, const Reference& ref) {
-  Row row{entry.op, library, entry.scope};
-  std::fprintf(stderr, "  %-9s %-10s", entry.op.c_str(), library.c_str());
-  try {
-    OpRun last;
-    for (int r = 0; r < reps; ++r) {
-      OpRun run = entry.run(ref.target_length);
-      row.wall_s = std::isnan(row.wall_s) ? run.wall_s : std::min(row.wall_s, run.wall_s);
-      row.cpu_s = std::isnan(row.cpu_s) ? run.cpu_s : std::min(row.cpu_s, run.cpu_s);
-      last = std::move(run);
+// One library's row of an operation while its runs are under way.
+struct Contender {
+  const OpEntry* entry;
+  Row row;
+  OpRun last;
+};
+
+// Runs every library once per round, in turn, `reps` rounds, so that a machine whose speed
+// drifts (a shared VM) slows every library alike; each row keeps its fastest run.
+void run_rounds(std::vector<Contender>& contenders, int reps, const Reference& ref) {
+  for (int r = 0; r < reps; ++r) {
+    for (Contender& c : contenders) {
+      if (!c.row.error.empty()) continue;
+      std::fprintf(stderr, "  %-9s %-22s round %d/%d", c.entry->op.c_str(), c.row.library.c_str(), r + 1, reps);
+      try {
+        OpRun run = c.entry->run(ref.target_length);
+        c.row.wall_s = std::isnan(c.row.wall_s) ? run.wall_s : std::min(c.row.wall_s, run.wall_s);
+        c.row.cpu_s = std::isnan(c.row.cpu_s) ? run.cpu_s : std::min(c.row.cpu_s, run.cpu_s);
+        c.last = std::move(run);
+        std::fprintf(stderr, " %8.3f s\n", c.last.wall_s);
+      } catch (const std::exception& e) {
+        c.row.error = e.what();
+        std::fprintf(stderr, " failed: %s\n", e.what());
+      }
     }
-    measure(row, last.output, ref);
-    std::fprintf(stderr, " %8.3f s\n", row.wall_s);
-  } catch (const std::exception& e) {
-    row.error = e.what();
-    std::fprintf(stderr, " failed: %s\n", e.what());
   }
-  return row;
 }
 
 // ---- the hosts, as separate processes ------------------------------------------------------
@@ -348,8 +356,10 @@ const char* op_title(const std::string& op) {
 }
 
 void print_table(const std::vector<Row>& rows, const std::string& mesh_name, const Reference& ref, int reps) {
-  std::printf("\n== hedge_bench operations: %s (%zu faces), fastest of %d run(s) in this process; hosts: 1 run ==\n",
-              mesh_name.c_str(), ref.mesh.n_faces(), reps);
+  std::printf(
+      "\n== hedge_bench operations: %s (%zu faces), fastest of %d round(s) in this process, the libraries in turn; "
+      "hosts: 1 run ==\n",
+      mesh_name.c_str(), ref.mesh.n_faces(), reps);
   std::printf(
       "ratio = peer wall time / hedge wall time (>1: hedge faster); Hausdorff: symmetric, sampled, as a "
       "fraction of the input's bounding-box diagonal (%.4g)\n\n",
@@ -414,9 +424,10 @@ int run_operation_table(int reps, bool hosts, const std::vector<std::string>& on
       {"CGAL", cgal_operations()},
       {"meshopt_simplify", meshopt_simplify_operations()},
       {"meshopt_simplifySloppy", meshopt_sloppy_operations()}};
-  std::fprintf(stderr, "operations on %s, %d run(s) each:\n", mesh_name.c_str(), reps);
+  std::fprintf(stderr, "operations on %s, %d round(s), every library once a round:\n", mesh_name.c_str(), reps);
   for (const char* op : kTableOps) {
     if (!only.empty() && std::find(only.begin(), only.end(), op) == only.end()) continue;
+    std::vector<Contender> contenders;
     for (const auto& [library, entries] : libraries) {
       bool first_hedge = true;
       for (const OpEntry& e : entries) {
@@ -426,8 +437,13 @@ int run_operation_table(int reps, bool hosts, const std::vector<std::string>& on
           name = first_hedge ? "hedge" : "hedge+io";
           first_hedge = false;
         }
-        rows.push_back(run_library(e, name, reps, ref));
+        contenders.push_back({&e, Row{e.op, name, e.scope}, {}});
       }
+    }
+    run_rounds(contenders, reps, ref);
+    for (Contender& c : contenders) {
+      if (c.row.error.empty()) measure(c.row, c.last.output, ref);
+      rows.push_back(std::move(c.row));
     }
   }
 
