@@ -53,8 +53,8 @@ struct DecimateOptions {
   //! A vertex attribute whose non-zero vertices are locked: they neither move nor go.
   //! Empty: none.
   std::string lock_attribute;
-  //! Threads for measuring every edge before the first collapse (the collapses themselves
-  //! are sequential); the result is the same for any count. 0: hedge::thread_count().
+  //! Threads for the set-up and for the collapses, which run region by region on all of
+  //! them until the last few; the result is the same for any count. 0: hedge::thread_count().
   unsigned threads = 0;
   //! Keep a copy of the mesh while working, so that a cancelled or failed run leaves it as
   //! it was. run_operation() turns it off: its mesh is built for the run and dropped on failure.
