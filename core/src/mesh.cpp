@@ -265,7 +265,9 @@ template <class Array, class F>
 void gather(Array& data, std::span<const Index> new_to_old, F f) {
   Array out(new_to_old.size());
   parallel_for(new_to_old.size(), 0, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i) out[i] = f(data[new_to_old[i]]);
+    detail::gather_ahead(
+        new_to_old.data(), begin, end, [&](Index j) { return &data[j]; },
+        [&](std::size_t i, Index j) { out[i] = f(data[j]); });
   });
   data.swap(out);
 }

@@ -63,8 +63,9 @@ void ChannelArray::interpolate(std::size_t to, std::span<const Index> from, std:
 
 void ChannelArray::permute(std::span<const Index> new_to_old) {
   std::vector<std::byte> out(new_to_old.size() * stride_);
-  for (std::size_t i = 0; i < new_to_old.size(); ++i)
-    std::memcpy(out.data() + i * stride_, element(new_to_old[i]), stride_);
+  detail::gather_ahead(
+      new_to_old.data(), 0, new_to_old.size(), [&](Index j) { return element(j); },
+      [&](std::size_t i, Index j) { std::memcpy(out.data() + i * stride_, element(j), stride_); });
   data_.swap(out);
 }
 

@@ -14,6 +14,7 @@
 #include <utility>
 #include <vector>
 
+#include "hedge/detail/memory.h"
 #include "hedge/error.h"
 #include "hedge/handles.h"
 #include "hedge/provenance.h"
@@ -143,7 +144,13 @@ class TypedArray final : public PropertyArray {
   void permute(std::span<const Index> new_to_old) override {
     std::vector<T> out;
     out.reserve(new_to_old.size());
-    for (Index i : new_to_old) out.push_back(data_[i]);
+    if constexpr (std::is_same_v<T, bool>) {  // no address to fetch
+      for (Index i : new_to_old) out.push_back(data_[i]);
+    } else {
+      detail::gather_ahead(
+          new_to_old.data(), 0, new_to_old.size(), [&](Index j) { return &data_[j]; },
+          [&](std::size_t, Index j) { out.push_back(data_[j]); });
+    }
     data_.swap(out);
   }
   std::unique_ptr<PropertyArray> clone() const override { return std::make_unique<TypedArray>(*this); }

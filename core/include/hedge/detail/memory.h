@@ -58,4 +58,16 @@ inline void prefetch(const void* p) {
 #endif
 }
 
+//! each(i, new_to_old[i]) for i in [begin, end), the element at(new_to_old[i]) fetched some
+//! places ahead. What a compaction keeps lies scattered through the old array, too sparsely
+//! for the hardware to see a stream, so each element would otherwise wait on memory.
+template <class Index, class At, class Each>
+void gather_ahead(const Index* new_to_old, std::size_t begin, std::size_t end, At at, Each each) {
+  constexpr std::size_t kAhead = 16;
+  for (std::size_t i = begin; i < end; ++i) {
+    if (i + kAhead < end) prefetch(at(new_to_old[i + kAhead]));
+    each(i, new_to_old[i]);
+  }
+}
+
 }  // namespace hedge::detail
