@@ -8,6 +8,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "hedge/detail/memory.h"
 #include "hedge/io.h"
 #include "io_detail.h"
 
@@ -275,6 +276,9 @@ class RunJoin {
     check_later(&ObjRun::later_vn, defined[kNormal], kNormal);
 
     Soup soup;
+    detail::reserve_on_huge_pages(soup.positions, defined[kVertex]);
+    detail::reserve_on_huge_pages(soup.face_sizes, faces_);
+    detail::reserve_on_huge_pages(soup.corners, corners_);
     soup.positions.resize(defined[kVertex]);
     soup.face_sizes.resize(faces_);
     soup.corners.resize(corners_);

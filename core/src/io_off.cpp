@@ -7,6 +7,7 @@
 #include <utility>
 #include <vector>
 
+#include "hedge/detail/memory.h"
 #include "hedge/io.h"
 #include "hedge/limits.h"
 #include "io_detail.h"
@@ -228,6 +229,7 @@ bool read_body_in_runs(std::string_view body, const std::string& name, std::uint
   for (std::size_t r = 0; r < n; ++r) corners_before[r + 1] += corners_before[r];
 
   // Pass 3: the elements; face colours, which are rare, by run and joined after.
+  detail::reserve_on_huge_pages(faces.corners, corners_before.back());
   faces.corners.resize(corners_before.back());
   std::vector<std::vector<std::uint8_t>> colors(n);
   regular = read_runs_or_give_way(n, [&](std::size_t r) {
@@ -313,6 +315,7 @@ Soup read_off(std::string_view bytes, const std::string& name) {
               "the header declares " + plural(nv, "vertex", "vertices") + " and " + plural(nf, "face") +
                   ", more than the rest of the file (" + plural(in.remaining(), "byte") + ") can hold");
 
+  detail::reserve_on_huge_pages(soup.positions, nv);
   soup.positions.resize(nv);
   std::vector<float> normals(header.normal ? nv * 3 : 0);
   std::vector<std::uint8_t> colors(header.color ? nv * 4 : 0);
@@ -328,7 +331,7 @@ Soup read_off(std::string_view bytes, const std::string& name) {
       vertices.read(in, v, rest);
     }
     faces.sizes.reserve(nf);
-    faces.corners.reserve(std::min<std::uint64_t>(nf * 3, in.remaining() / 2));
+    detail::reserve_on_huge_pages(faces.corners, std::min<std::uint64_t>(nf * 3, in.remaining() / 2));
     for (std::uint64_t f = 0; f < nf; ++f) {
       in.skip_space();
       if (in.at_end()) in.fail("file ends at face " + std::to_string(f) + " of " + std::to_string(nf));

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "hedge/detail/memory.h"
 #include "hedge/io.h"
 #include "hedge/limits.h"
 #include "io_detail.h"
@@ -317,17 +318,21 @@ struct Sink {
   }
   //! Room for nv vertices and nf faces, with their defaults.
   void size(std::uint64_t nv, std::uint64_t nf) {
-    soup.positions.resize(nv);
-    if (has_normal) normals.resize(3 * nv);
-    if (has_vertex_color) vertex_color.resize(4 * nv, 255);
-    if (has_vertex_quality) vertex_quality.resize(nv);
-    if (has_vertex_uv) vertex_uv.resize(2 * nv);
-    if (has_face_color) face_color.resize(4 * nf, 255);
-    if (has_face_quality) face_quality.resize(nf);
-    if (has_material) material.resize(nf);
-    if (has_vertex_selected) vertex_selected.resize(nv);
-    if (has_face_selected) face_selected.resize(nf);
-    soup.face_sizes.reserve(nf);
+    auto fill = [](auto& v, std::uint64_t n, auto value) {
+      detail::reserve_on_huge_pages(v, n);
+      v.resize(n, value);
+    };
+    fill(soup.positions, nv, Point{});
+    if (has_normal) fill(normals, 3 * nv, 0.0f);
+    if (has_vertex_color) fill(vertex_color, 4 * nv, std::uint8_t{255});
+    if (has_vertex_quality) fill(vertex_quality, nv, 0.0f);
+    if (has_vertex_uv) fill(vertex_uv, 2 * nv, 0.0f);
+    if (has_face_color) fill(face_color, 4 * nf, std::uint8_t{255});
+    if (has_face_quality) fill(face_quality, nf, 0.0f);
+    if (has_material) fill(material, nf, std::int32_t{0});
+    if (has_vertex_selected) fill(vertex_selected, nv, std::uint8_t{0});
+    if (has_face_selected) fill(face_selected, nf, std::uint8_t{0});
+    detail::reserve_on_huge_pages(soup.face_sizes, nf);
   }
 };
 
@@ -664,6 +669,7 @@ bool read_text_in_runs(std::string_view bytes, const Header& header, const std::
     s.take_targets(header);
     s.vertex_base = range(first_vertex, nv, a), s.face_base = range(first_face, nf, a);
     s.size(range(first_vertex, nv, b) - s.vertex_base, range(first_face, nf, b) - s.face_base);
+    s.soup.corners.reserve(3 * (range(first_face, nf, b) - s.face_base));  // triangles need no regrowth
     Place place;
     AsciiSource in(text[r], name, place);
     read_body(in, header, place, s, a, b);
@@ -730,7 +736,7 @@ Soup read_ply(std::string_view bytes, const std::string& name) {
     if (e.kind == Kind::face)
       for (const PlyProperty& p : e.properties)
         if (p.target == Target::indices && header.encoding != Encoding::ascii) index_bytes = type_size(p.type);
-  soup.corners.reserve(std::min<std::uint64_t>(3 * nf, body_bytes / index_bytes));
+  detail::reserve_on_huge_pages(soup.corners, std::min<std::uint64_t>(3 * nf, body_bytes / index_bytes));
 
   Place place;
   switch (header.encoding) {

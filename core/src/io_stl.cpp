@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "hedge/detail/memory.h"
 #include "hedge/io.h"
 #include "hedge/limits.h"
 #include "io_detail.h"
@@ -59,7 +60,8 @@ void weld(const std::vector<Point>& raw, Soup& soup) {
   std::vector<std::uint32_t> table(capacity, kEmpty);
   std::vector<Key> keys;
   keys.reserve(raw.size() / 4);
-  soup.positions.reserve(raw.size() / 4);
+  detail::reserve_on_huge_pages(soup.positions, raw.size() / 4);
+  detail::reserve_on_huge_pages(soup.corners, raw.size());
   soup.corners.resize(raw.size());
   for (std::size_t i = 0; i < raw.size(); ++i) {
     Key k = key_of(raw[i]);

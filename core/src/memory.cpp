@@ -2,6 +2,7 @@
 #include "hedge/detail/memory.h"
 
 #include <algorithm>
+#include <cstdint>
 #include <cstdlib>
 
 #ifdef __linux__
@@ -10,8 +11,11 @@
 
 namespace hedge::detail {
 
+namespace {
+constexpr std::size_t kHugePage = std::size_t(2) << 20;
+}
+
 void* allocate_array(std::size_t bytes, std::size_t alignment) {
-  constexpr std::size_t kHugePage = std::size_t(2) << 20;
   alignment = std::max(alignment, alignof(std::max_align_t));
   const std::size_t unit = bytes >= kHugePage ? kHugePage : alignment;
   // aligned_alloc wants a multiple of the alignment; at least one unit, so that an empty
@@ -27,5 +31,16 @@ void* allocate_array(std::size_t bytes, std::size_t alignment) {
 }
 
 void free_array(void* p) noexcept { std::free(p); }
+
+void advise_huge_pages(const void* p, std::size_t bytes) noexcept {
+#ifdef __linux__
+  const auto begin = reinterpret_cast<std::uintptr_t>(p);
+  const std::uintptr_t first = (begin + kHugePage - 1) / kHugePage * kHugePage;
+  const std::uintptr_t last = (begin + bytes) / kHugePage * kHugePage;
+  if (last > first) madvise(reinterpret_cast<void*>(first), last - first, MADV_HUGEPAGE);  // only a hint
+#else
+  (void)p, (void)bytes;
+#endif
+}
 
 }  // namespace hedge::detail

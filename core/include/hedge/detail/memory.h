@@ -20,6 +20,19 @@ namespace hedge::detail {
 void* allocate_array(std::size_t bytes, std::size_t alignment);
 void free_array(void* p) noexcept;
 
+//! Asks for huge pages, as allocate_array() does, under the whole 2 MiB pages that lie inside
+//! [p, p + bytes): for a big array another allocator made, before its first touch.
+void advise_huge_pages(const void* p, std::size_t bytes) noexcept;
+
+//! v.reserve(n) for an empty std::vector, its memory on huge pages where whole ones fit: the
+//! readers' and extract()'s big arrays, whose type the soup's interface fixes.
+template <class Vector>
+void reserve_on_huge_pages(Vector& v, std::size_t n) {
+  if (n <= v.capacity()) return;
+  v.reserve(n);
+  advise_huge_pages(v.data(), v.capacity() * sizeof(*v.data()));
+}
+
 //! std::allocator, except that an element made without a value (resize(n), emplace_back())
 //! is left unset. The mesh's connectivity arrays use it so that a builder that writes every
 //! field itself (Mesh::resize_unset) does not pay for a fill first: on a big mesh that fill
