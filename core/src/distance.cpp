@@ -125,11 +125,14 @@ struct BuildNode {
   Index index, count;
 };
 
+// Every node's fields are written as it is made, so the array needs no fill.
+using BuildNodes = std::vector<BuildNode, detail::UnsetAllocator<BuildNode>>;
+
 // Builds the hierarchy over refs[begin, end) depth first (a node's first child directly
 // follows it); box and cbox bound the range's triangles and centroids, computed by the
 // parent's bins so every level costs one pass.
 struct Builder {
-  std::vector<Ref>& refs;
+  std::vector<Ref, detail::UnsetAllocator<Ref>>& refs;
 
   // Chooses the split: fills the bounds of both sides and returns the middle, or begin
   // when the range should stay a leaf.
@@ -144,12 +147,25 @@ struct Builder {
     if (!(extent > 0)) return begin;  // all centroids coincide
     const float scale = static_cast<float>(kBins / extent), lo_f = static_cast<float>(lo);
     auto bin_of = [&](const Ref& r) { return std::min(kBins - 1, static_cast<int>((r.c[axis] - lo_f) * scale)); };
-    for (Index i = begin; i < end; ++i) {
-      const Ref& r = refs[i];
-      Bin& bin = bins[bin_of(r)];
+    // Neighbouring triangles mostly fall in one bin, where each bound would wait for the
+    // last one's: two sets of bins, taking the triangles in turn, halve those chains.
+    Bin other_bins[kBins];
+    auto put = [&](Bin* set, const Ref& r) {
+      Bin& bin = set[bin_of(r)];
       ++bin.count;
       bin.box.add(r.box);
       bin.cbox.add(r.c[0], r.c[1], r.c[2]);
+    };
+    Index i = begin;
+    for (; i + 1 < end; i += 2) {
+      put(bins, refs[i]);
+      put(other_bins, refs[i + 1]);
+    }
+    if (i < end) put(bins, refs[i]);
+    for (int b = 0; b < kBins; ++b) {
+      bins[b].count += other_bins[b].count;
+      bins[b].box.add(other_bins[b].box);
+      bins[b].cbox.add(other_bins[b].cbox);
     }
     const Index count = end - begin;
     int best_split = 0;
@@ -195,7 +211,7 @@ struct Builder {
     }
   }
 
-  Index build(Index begin, Index end, const Box& box, const Box& cbox, std::vector<BuildNode>& nodes, int depth) {
+  Index build(Index begin, Index end, const Box& box, const Box& cbox, BuildNodes& nodes, int depth) {
     Index id = static_cast<Index>(nodes.size());
     nodes.emplace_back();
     set_box(nodes[id], box);
@@ -224,7 +240,7 @@ struct Builder {
 
   // The root's two subtrees on two threads (when there are two), then the second appended
   // to the first.
-  void build_parallel(Index n, const Box& box, const Box& cbox, std::vector<BuildNode>& nodes) {
+  void build_parallel(Index n, const Box& box, const Box& cbox, BuildNodes& nodes) {
     Box child_box[2], child_cbox[2];
     Index mid = n > 65536 ? split(0, n, cbox, child_box, child_cbox) : 0;
     if (mid == 0) {
@@ -233,7 +249,7 @@ struct Builder {
     }
     nodes.emplace_back();
     set_box(nodes[0], box);
-    std::vector<BuildNode> right;
+    BuildNodes right;
     auto build_right = [&] {
       right.reserve(2 * (n - mid) / kLeafSize + 1);
       build(mid, n, child_box[1], child_cbox[1], right, 1);
@@ -281,8 +297,9 @@ inline double box_distance_sq(const float lo[3], const float hi[3], const Vec3d&
 }  // namespace
 
 TriangleTree::TriangleTree(const Mesh& mesh) {
-  std::vector<Triangle> tris;
+  Array<Triangle> tris;
   tris.reserve(mesh.n_faces() + mesh.n_faces() / 4);
+  faces_.reserve(tris.capacity());
   for (Face f : mesh.faces()) {
     Halfedge h0 = mesh.halfedge(f);
     const Point& a = mesh.position(mesh.to_vertex(h0));
@@ -291,13 +308,13 @@ TriangleTree::TriangleTree(const Mesh& mesh) {
       faces_.push_back(f);
     }
   }
-  std::vector<Index> original(tris.size());
+  Array<Index> original(tris.size());
   for (std::size_t i = 0; i < original.size(); ++i) original[i] = static_cast<Index>(i);
   build(std::move(tris), std::move(original));
 }
 
 TriangleTree::TriangleTree(std::span<const Point> positions, std::span<const std::array<Index, 3>> triangles) {
-  std::vector<Triangle> tris;
+  Array<Triangle> tris;
   tris.reserve(triangles.size());
   for (std::size_t i = 0; i < triangles.size(); ++i) {
     const auto& t = triangles[i];
@@ -307,20 +324,21 @@ TriangleTree::TriangleTree(std::span<const Point> positions, std::span<const std
                     std::to_string(positions.size()) + " positions");
     tris.push_back({positions[t[0]], positions[t[1]], positions[t[2]]});
   }
-  std::vector<Index> original(tris.size());
+  Array<Index> original(tris.size());
   for (std::size_t i = 0; i < original.size(); ++i) original[i] = static_cast<Index>(i);
   build(std::move(tris), std::move(original));
 }
 
-void TriangleTree::build(std::vector<Triangle> tris, std::vector<Index> original) {
+void TriangleTree::build(Array<Triangle> tris, Array<Index> original) {
   static_assert(sizeof(Node) == sizeof(BuildNode));
   const std::size_t n = tris.size();
   if (n >= kInvalidIndex / 2) throw Error("too many triangles for the distance tree");
-  std::vector<Ref> refs(n);
+  std::vector<Ref, detail::UnsetAllocator<Ref>> refs(n);  // each written below
   parallel_for(n, 0, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
       const Triangle& t = tris[i];
       Ref& r = refs[i];
+      r.box = Box();
       for (const Point* p : {&t.a, &t.b, &t.c}) r.box.add((*p)[0], (*p)[1], (*p)[2]);
       for (int k = 0; k < 3; ++k) r.c[k] = (t.a[k] + t.b[k] + t.c[k]) / 3.0f;
       r.id = static_cast<Index>(i);
@@ -332,7 +350,7 @@ void TriangleTree::build(std::vector<Triangle> tris, std::vector<Index> original
     cbox.add(r.c[0], r.c[1], r.c[2]);
   }
 
-  std::vector<BuildNode> nodes;
+  BuildNodes nodes;
   if (n > 0) {
     nodes.reserve(2 * n / kLeafSize + 1);
     Builder{refs}.build_parallel(static_cast<Index>(n), box, cbox, nodes);

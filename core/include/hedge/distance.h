@@ -82,15 +82,19 @@ class TriangleTree {
   struct Triangle {
     Point a, b, c;
   };
-  void build(std::vector<Triangle> triangles, std::vector<Index> original);
+  // The tree's arrays, tens of megabytes on a big mesh: on huge pages, and written whole
+  // without a fill first (detail::UnsetAllocator).
+  template <class T>
+  using Array = std::vector<T, detail::UnsetAllocator<T>>;
+  void build(Array<Triangle> triangles, Array<Index> original);
   //! With `facing`, only triangles whose normal points to its side (positive dot product).
   void search(const Vec3d& p, ClosestPoint& best, double& best_sq, const Vec3d* facing = nullptr) const;
 
-  std::vector<Node> nodes_;
-  std::vector<Triangle> triangles_;  //!< in tree (leaf) order
-  std::vector<Index> original_;      //!< tree order -> caller's triangle index
-  std::vector<Index> position_;      //!< caller's triangle index -> tree order
-  std::vector<Face> faces_;          //!< caller's triangle index -> mesh face
+  Array<Node> nodes_;
+  Array<Triangle> triangles_;  //!< in tree (leaf) order
+  Array<Index> original_;      //!< tree order -> caller's triangle index
+  Array<Index> position_;      //!< caller's triangle index -> tree order
+  Array<Face> faces_;          //!< caller's triangle index -> mesh face
 };
 
 struct HausdorffOptions {
