@@ -1307,8 +1307,7 @@ Soup extract(const Mesh& mesh, const ExtractOptions& options, ExtractReport* rep
     return vertices_identity ? static_cast<std::uint32_t>(i) : order[i];
   };
 
-  detail::reserve_on_huge_pages(soup.positions, n_out_vertices);
-  soup.positions.resize(n_out_vertices);
+  detail::resize_on_huge_pages(soup.positions, n_out_vertices);
   if (vertices_identity) {
     if (nvs) std::memcpy(soup.positions.data(), mesh.positions().data(), nvs * sizeof(Point));
   } else {
@@ -1342,10 +1341,8 @@ Soup extract(const Mesh& mesh, const ExtractOptions& options, ExtractReport* rep
     r.faces = n_faces, r.corners = n_corners;  // from here on: where the range's output starts
     n_faces += faces, n_corners += corners;
   }
-  detail::reserve_on_huge_pages(soup.face_sizes, n_faces);
-  detail::reserve_on_huge_pages(soup.corners, n_corners);
-  soup.face_sizes.resize(n_faces);
-  soup.corners.resize(n_corners);
+  detail::resize_on_huge_pages(soup.face_sizes, n_faces);
+  detail::resize_on_huge_pages(soup.corners, n_corners);
   std::vector<std::uint32_t> corner_halfedge(has_corner_channels ? n_corners : 0);
   parallel_for(
       ranges.size(), 0,

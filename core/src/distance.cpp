@@ -125,6 +125,8 @@ struct BuildNode {
   Index index, count;
 };
 
+// The triangles while building, each written before it is read.
+using Refs = std::vector<Ref, detail::UnsetAllocator<Ref>>;
 // Every node's fields are written as it is made, so the array needs no fill.
 using BuildNodes = std::vector<BuildNode, detail::UnsetAllocator<BuildNode>>;
 
@@ -132,7 +134,7 @@ using BuildNodes = std::vector<BuildNode, detail::UnsetAllocator<BuildNode>>;
 // follows it); box and cbox bound the range's triangles and centroids, computed by the
 // parent's bins so every level costs one pass.
 struct Builder {
-  std::vector<Ref, detail::UnsetAllocator<Ref>>& refs;
+  Refs& refs;
 
   // Chooses the split: fills the bounds of both sides and returns the middle, or begin
   // when the range should stay a leaf.
@@ -333,7 +335,7 @@ void TriangleTree::build(Array<Triangle> tris, Array<Index> original) {
   static_assert(sizeof(Node) == sizeof(BuildNode));
   const std::size_t n = tris.size();
   if (n >= kInvalidIndex / 2) throw Error("too many triangles for the distance tree");
-  std::vector<Ref, detail::UnsetAllocator<Ref>> refs(n);  // each written below
+  Refs refs(n);
   parallel_for(n, 0, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
       const Triangle& t = tris[i];

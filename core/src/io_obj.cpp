@@ -276,12 +276,9 @@ class RunJoin {
     check_later(&ObjRun::later_vn, defined[kNormal], kNormal);
 
     Soup soup;
-    detail::reserve_on_huge_pages(soup.positions, defined[kVertex]);
-    detail::reserve_on_huge_pages(soup.face_sizes, faces_);
-    detail::reserve_on_huge_pages(soup.corners, corners_);
-    soup.positions.resize(defined[kVertex]);
-    soup.face_sizes.resize(faces_);
-    soup.corners.resize(corners_);
+    detail::resize_on_huge_pages(soup.positions, defined[kVertex]);
+    detail::resize_on_huge_pages(soup.face_sizes, faces_);
+    detail::resize_on_huge_pages(soup.corners, corners_);
     std::vector<float> texcoords(2 * defined[kTexcoord]), normals(3 * defined[kNormal]);
     float* color = colors ? soup.add_channel("color", Domain::vertex, ScalarType::f32, 4).as<float>() : nullptr;
     std::int32_t* material =

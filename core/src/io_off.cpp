@@ -229,8 +229,7 @@ bool read_body_in_runs(std::string_view body, const std::string& name, std::uint
   for (std::size_t r = 0; r < n; ++r) corners_before[r + 1] += corners_before[r];
 
   // Pass 3: the elements; face colours, which are rare, by run and joined after.
-  detail::reserve_on_huge_pages(faces.corners, corners_before.back());
-  faces.corners.resize(corners_before.back());
+  detail::resize_on_huge_pages(faces.corners, corners_before.back());
   std::vector<std::vector<std::uint8_t>> colors(n);
   regular = read_runs_or_give_way(n, [&](std::size_t r) {
     TextScanner in(text[r], name, '#');
@@ -315,8 +314,7 @@ Soup read_off(std::string_view bytes, const std::string& name) {
               "the header declares " + plural(nv, "vertex", "vertices") + " and " + plural(nf, "face") +
                   ", more than the rest of the file (" + plural(in.remaining(), "byte") + ") can hold");
 
-  detail::reserve_on_huge_pages(soup.positions, nv);
-  soup.positions.resize(nv);
+  detail::resize_on_huge_pages(soup.positions, nv);
   std::vector<float> normals(header.normal ? nv * 3 : 0);
   std::vector<std::uint8_t> colors(header.color ? nv * 4 : 0);
   std::vector<float> uvs(header.texture ? nv * 2 : 0);

@@ -318,20 +318,17 @@ struct Sink {
   }
   //! Room for nv vertices and nf faces, with their defaults.
   void size(std::uint64_t nv, std::uint64_t nf) {
-    auto fill = [](auto& v, std::uint64_t n, auto value) {
-      detail::reserve_on_huge_pages(v, n);
-      v.resize(n, value);
-    };
-    fill(soup.positions, nv, Point{});
-    if (has_normal) fill(normals, 3 * nv, 0.0f);
-    if (has_vertex_color) fill(vertex_color, 4 * nv, std::uint8_t{255});
-    if (has_vertex_quality) fill(vertex_quality, nv, 0.0f);
-    if (has_vertex_uv) fill(vertex_uv, 2 * nv, 0.0f);
-    if (has_face_color) fill(face_color, 4 * nf, std::uint8_t{255});
-    if (has_face_quality) fill(face_quality, nf, 0.0f);
-    if (has_material) fill(material, nf, std::int32_t{0});
-    if (has_vertex_selected) fill(vertex_selected, nv, std::uint8_t{0});
-    if (has_face_selected) fill(face_selected, nf, std::uint8_t{0});
+    using detail::resize_on_huge_pages;
+    resize_on_huge_pages(soup.positions, nv);
+    if (has_normal) resize_on_huge_pages(normals, 3 * nv);
+    if (has_vertex_color) resize_on_huge_pages(vertex_color, 4 * nv, 255);
+    if (has_vertex_quality) resize_on_huge_pages(vertex_quality, nv);
+    if (has_vertex_uv) resize_on_huge_pages(vertex_uv, 2 * nv);
+    if (has_face_color) resize_on_huge_pages(face_color, 4 * nf, 255);
+    if (has_face_quality) resize_on_huge_pages(face_quality, nf);
+    if (has_material) resize_on_huge_pages(material, nf);
+    if (has_vertex_selected) resize_on_huge_pages(vertex_selected, nv);
+    if (has_face_selected) resize_on_huge_pages(face_selected, nf);
     detail::reserve_on_huge_pages(soup.face_sizes, nf);
   }
 };

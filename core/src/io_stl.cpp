@@ -61,8 +61,7 @@ void weld(const std::vector<Point>& raw, Soup& soup) {
   std::vector<Key> keys;
   keys.reserve(raw.size() / 4);
   detail::reserve_on_huge_pages(soup.positions, raw.size() / 4);
-  detail::reserve_on_huge_pages(soup.corners, raw.size());
-  soup.corners.resize(raw.size());
+  detail::resize_on_huge_pages(soup.corners, raw.size());
   for (std::size_t i = 0; i < raw.size(); ++i) {
     Key k = key_of(raw[i]);
     std::size_t slot = hash(k) & mask;

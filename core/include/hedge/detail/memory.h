@@ -33,6 +33,13 @@ void reserve_on_huge_pages(Vector& v, std::size_t n) {
   advise_huge_pages(v.data(), v.capacity() * sizeof(*v.data()));
 }
 
+//! v.resize(n, value) for an empty std::vector, on huge pages as above.
+template <class Vector>
+void resize_on_huge_pages(Vector& v, std::size_t n, const typename Vector::value_type& value = {}) {
+  reserve_on_huge_pages(v, n);
+  v.resize(n, value);
+}
+
 //! std::allocator, except that an element made without a value (resize(n), emplace_back())
 //! is left unset. The mesh's connectivity arrays use it so that a builder that writes every
 //! field itself (Mesh::resize_unset) does not pay for a fill first: on a big mesh that fill
